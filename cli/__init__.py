@@ -1,0 +1,1 @@
+"""Command-line front ends (installed as the ``sgdata_cli`` package): parse, call, print."""

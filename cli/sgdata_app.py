@@ -1,0 +1,111 @@
+"""The ``sgdata`` command: thin typer front end over the sgdata library."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from .errors import run_app
+
+app = typer.Typer(
+    name="sgdata",
+    help="Generate, validate and serve scene-graph datasets of rooms whose objects move.",
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+    add_completion=False,
+)
+console = Console()
+
+
+@app.command()
+def rooms(
+    out: Annotated[Path, typer.Argument(help="Directory to write <room_id>/room.usda into.")],
+    room_type: Annotated[
+        str, typer.Option("--type", help="kitchen | living_room | bedroom | bathroom")
+    ] = "kitchen",
+    count: Annotated[int, typer.Option(help="How many rooms.")] = 1,
+    seed: Annotated[int, typer.Option(help="Dataset seed; each room derives its own.")] = 0,
+    first_index: Annotated[int, typer.Option(help="Index of the first room.")] = 0,
+) -> None:
+    """Generate procedural rooms and write them as USD stages."""
+    from sgdata.rooms import room_stats
+    from sgdata.scenes import write_rooms
+
+    made = write_rooms(out, room_type, count=count, seed=seed, first_index=first_index)
+    table = Table(title=f"{len(made)} {room_type} room(s) in {out}")
+    for column in ("room", "size (m)", "objects", "static", "low", "high", "classes"):
+        table.add_column(column, justify="left" if column == "room" else "right")
+    for room in made:
+        stats = room_stats(room)
+        table.add_row(
+            room.room_id,
+            f"{room.width:.2f} x {room.depth:.2f} x {room.height:.2f}",
+            str(stats.objects),
+            str(stats.by_dynamics["static"]),
+            str(stats.by_dynamics["low"]),
+            str(stats.by_dynamics["high"]),
+            str(stats.classes),
+        )
+    console.print(table)
+
+
+@app.command()
+def layouts(
+    room_dir: Annotated[Path, typer.Argument(help="A room directory holding room.usda.")],
+    count: Annotated[int, typer.Option(help="Layouts to write, layout 0 being the base.")] = 5,
+    seed: Annotated[int, typer.Option(help="Seed of the layouts (mixed with the room's).")] = 0,
+) -> None:
+    """Sample layouts of a room under the dynamics rules and write them as USD layers."""
+    from sgdata.dynamics import summarize_layouts
+    from sgdata.scenes import write_layouts
+
+    made = write_layouts(room_dir, count=count, seed=seed)
+    table = Table(title=f"{len(made)} layout(s) of {room_dir}")
+    for column in ("layout", "moved", "carried", "stayed put", "seed"):
+        table.add_column(column, justify="right")
+    for layout in made:
+        rules = [m.rule for m in layout.moves if m.moved]
+        table.add_row(
+            str(layout.index),
+            str(sum(r != "carried" for r in rules)),
+            str(rules.count("carried")),
+            str(sum(not m.moved for m in layout.moves)),
+            str(layout.seed),
+        )
+    console.print(table)
+    for line in summarize_layouts(made).lines():
+        console.print(line)
+
+
+@app.command()
+def preview(
+    stage: Annotated[Path, typer.Argument(help="A room.usda or layout_<k>.usda file.")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="PNG to write.")] = Path(
+        "top.png"
+    ),
+    compare: Annotated[
+        bool, typer.Option(help="For a layout: draw it beside the base room, moves in red.")
+    ] = False,
+) -> None:
+    """Write a top-down picture of a room or layout with class labels."""
+    from sgdata.preview import draw_layout_pair, draw_room, save_png
+    from sgdata.usd_io import read_room
+
+    room = read_room(stage)
+    if compare:
+        base = read_room(stage.parent / "room.usda")
+        image = draw_layout_pair(base, room, title=stage.stem)
+    else:
+        image = draw_room(room)
+    save_png(image, output)
+    console.print(f"wrote {output} ({image.width}x{image.height})")
+
+
+main = run_app(app, "sgdata")
+
+if __name__ == "__main__":
+    main()

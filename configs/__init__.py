@@ -1,0 +1,1 @@
+"""Generation and training presets (TOML files, no code)."""

@@ -1,0 +1,1 @@
+"""SeanNet: the scene-embedding network and its trainer (PyTorch side)."""

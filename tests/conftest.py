@@ -1,0 +1,170 @@
+"""Shared test fixtures: a tiny hand-built room with its render geometry, and one renderer."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+import numpy as np
+import pytest
+import trimesh
+
+from sgdata.meshes import MeshData, ObjectGeometry, SceneGeometry
+from sgdata.scene import Dynamics, Opening, Placement, Room, SceneObject
+
+# The camera pose from which the tiny room's interesting objects are all in view.
+TINY_VIEW = (2.5, 0.5, np.pi / 2)  # x, y, theta: standing near the south wall, looking north
+
+
+@dataclass(frozen=True)
+class TinyRoom:
+    """The tiny room: its model, its render geometry, and names for its instances."""
+
+    room: Room
+    geometry: SceneGeometry
+    ids: dict[str, int]
+
+
+def _mesh(parts: list[trimesh.Trimesh], color: tuple[float, float, float]) -> MeshData:
+    m = trimesh.util.concatenate(parts)
+    return MeshData(
+        vertices=np.asarray(m.vertices, dtype=np.float64),
+        faces=np.asarray(m.faces, dtype=np.int32),
+        face_colors=np.tile(np.asarray(color, dtype=np.float32), (len(m.faces), 1)),
+    )
+
+
+def _box(
+    extents: tuple[float, float, float], center: tuple[float, float, float]
+) -> trimesh.Trimesh:
+    b = trimesh.creation.box(extents=extents)
+    b.apply_translation(center)
+    return b
+
+
+def _block(size: tuple[float, float, float]) -> list[trimesh.Trimesh]:
+    """A solid box in the local frame (origin at the bottom centre)."""
+    return [_box(size, (0.0, 0.0, size[2] / 2))]
+
+
+def _table(size: tuple[float, float, float]) -> list[trimesh.Trimesh]:
+    w, d, h = size
+    top = _box((w, d, 0.04), (0, 0, h - 0.02))
+    legs = [
+        _box((0.05, 0.05, h - 0.04), (sx * (w / 2 - 0.025), sy * (d / 2 - 0.025), (h - 0.04) / 2))
+        for sx in (-1, 1)
+        for sy in (-1, 1)
+    ]
+    return [top, *legs]
+
+
+def _shelving(size: tuple[float, float, float]) -> list[trimesh.Trimesh]:
+    """An open-front frame: two sides, bottom, top and back (the board is its own object)."""
+    w, d, h, t = *size, 0.02
+    return [
+        _box((t, d, h), (-w / 2 + t / 2, 0, h / 2)),
+        _box((t, d, h), (w / 2 - t / 2, 0, h / 2)),
+        _box((w, d, t), (0, 0, t / 2)),
+        _box((w, d, t), (0, 0, h - t / 2)),
+        _box((w, t, h), (0, d / 2 - t / 2, h / 2)),
+    ]
+
+
+def _mug(size: tuple[float, float, float]) -> list[trimesh.Trimesh]:
+    c = trimesh.creation.cylinder(radius=size[0] / 2, height=size[2], sections=16)
+    c.apply_translation((0, 0, size[2] / 2))
+    return [c]
+
+
+def build_tiny_room() -> TinyRoom:
+    """A 5 x 4 m room: a mug on a table, a book on a board inside a shelving unit, two chairs
+    side by side, and a crate hidden behind the north wall."""
+    width, depth, height = 5.0, 4.0, 2.6
+    specs = [
+        # name, instance, class, dynamics, size, placement, support, attached_to, colour, shape
+        ("table", 1, "DiningTable", Dynamics.LOW, (1.0, 0.6, 0.75), (1.3, 2.8, 0.0), None, None,
+         (0.45, 0.25, 0.1), _table),
+        ("mug", 2, "Mug", Dynamics.HIGH, (0.12, 0.12, 0.14), (1.3, 2.7, 0.75), 1, None,
+         (0.8, 0.1, 0.1), _mug),
+        ("unit", 3, "ShelvingUnit", Dynamics.LOW, (0.8, 0.4, 1.2), (4.0, 3.0, 0.0), None, None,
+         (0.5, 0.5, 0.55), _shelving),
+        ("board", 5, "Shelf", Dynamics.STATIC, (0.76, 0.36, 0.02), (4.0, 2.99, 0.55), None, 3,
+         (0.6, 0.45, 0.3), _block),
+        ("book", 4, "Book", Dynamics.HIGH, (0.3, 0.22, 0.08), (4.0, 2.95, 0.57), 5, None,
+         (0.1, 0.2, 0.8), _block),
+        ("chair_a", 6, "Chair", Dynamics.HIGH, (0.45, 0.45, 0.9), (2.5, 2.0, 0.0), None, None,
+         (0.1, 0.5, 0.2), _block),
+        ("chair_b", 7, "Chair", Dynamics.HIGH, (0.45, 0.45, 0.9), (3.0, 2.0, 0.0), None, None,
+         (0.9, 0.7, 0.1), _block),
+        ("crate", 8, "Box", Dynamics.HIGH, (0.5, 0.5, 0.5), (2.5, 4.5, 0.0), None, None,
+         (0.9, 0.2, 0.9), _block),
+    ]  # fmt: skip
+    objects, geoms, ids = [], [], {}
+    for name, inst, cls, dyn, size, (x, y, z), sup, att, color, shape in specs:
+        obj = SceneObject(
+            instance=inst,
+            class_name=cls,
+            dynamics=dyn,
+            size=size,
+            placement=Placement(x, y, z),
+            color=color,
+            support=sup,
+            attached_to=att,
+        )
+        objects.append(obj)
+        geoms.append(ObjectGeometry(inst, cls, _mesh(shape(size), color), obj.placement.matrix()))
+        ids[name] = inst
+    t = 0.1
+    structure = (
+        _mesh([_box((width, depth, t), (width / 2, depth / 2, -t / 2))], (0.55, 0.5, 0.45)),
+        _mesh([_box((width, depth, t), (width / 2, depth / 2, height + t / 2))], (0.9, 0.9, 0.9)),
+        _mesh(
+            [
+                _box((width + 2 * t, t, height), (width / 2, -t / 2, height / 2)),
+                _box((width + 2 * t, t, height), (width / 2, depth + t / 2, height / 2)),
+                _box((t, depth, height), (-t / 2, depth / 2, height / 2)),
+                _box((t, depth, height), (width + t / 2, depth / 2, height / 2)),
+            ],
+            (0.8, 0.78, 0.7),
+        ),
+    )
+    room = Room(
+        room_id="tiny_000",
+        room_type="living_room",
+        width=width,
+        depth=depth,
+        height=height,
+        seed=0,
+        door=Opening("south", center=1.0, width=0.9, bottom=0.0, top=2.0),
+        objects=tuple(objects),
+    )
+    return TinyRoom(room, SceneGeometry(structure=structure, objects=tuple(geoms)), ids)
+
+
+@pytest.fixture(scope="session")
+def tiny_room() -> TinyRoom:
+    """The tiny room (see :func:`build_tiny_room`)."""
+    return build_tiny_room()
+
+
+@pytest.fixture(scope="session")
+def renderer() -> Iterator[object]:
+    """One EGL renderer for the whole session (building contexts is slow)."""
+    from sgdata.render import Renderer
+
+    r = Renderer()
+    yield r
+    r.close()
+
+
+@pytest.fixture
+def tiny_renderer(renderer: object, tiny_room: TinyRoom) -> object:
+    """The session renderer holding the tiny room's default layout."""
+    renderer.update_poses(tiny_room.geometry)  # type: ignore[attr-defined]
+    return renderer
+
+
+@pytest.fixture(scope="session")
+def tiny_view() -> tuple[float, float, float]:
+    """(x, y, theta) from which every interesting object of the tiny room is in view."""
+    return TINY_VIEW
