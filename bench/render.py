@@ -43,6 +43,7 @@ def generated_scenes(n: int, seed: int) -> list[tuple[Room, SceneGeometry]]:
     from sgdata import usd_io
     from sgdata.catalog import load_catalog
     from sgdata.rooms import generate_room
+    from sgdata.usd_geometry import read_geometry
 
     catalog = load_catalog()
     types = ["kitchen", "living_room", "bedroom", "bathroom"]
@@ -52,7 +53,7 @@ def generated_scenes(n: int, seed: int) -> list[tuple[Room, SceneGeometry]]:
         room = generate_room(types[k % len(types)], k // len(types), seed, catalog)
         path = tmp / f"{room.room_id}.usda"
         usd_io.write_room(room, path, geometry=usd_io.catalog_geometry(catalog))
-        out.append((room, usd_io.read_geometry(path)))
+        out.append((room, read_geometry(path)))
     return out
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated
 
+import numpy as np
 import typer
 from rich.console import Console
 from rich.table import Table
@@ -84,9 +85,7 @@ def layouts(
 @app.command()
 def preview(
     stage: Annotated[Path, typer.Argument(help="A room.usda or layout_<k>.usda file.")],
-    output: Annotated[Path, typer.Option("-o", "--output", help="PNG to write.")] = Path(
-        "top.png"
-    ),
+    output: Annotated[Path, typer.Option("-o", "--output", help="PNG to write.")] = Path("top.png"),
     compare: Annotated[
         bool, typer.Option(help="For a layout: draw it beside the base room, moves in red.")
     ] = False,
@@ -103,6 +102,38 @@ def preview(
         image = draw_room(room)
     save_png(image, output)
     console.print(f"wrote {output} ({image.width}x{image.height})")
+
+
+@app.command()
+def render(
+    room_dir: Annotated[Path, typer.Argument(help="A room directory with its layouts.")],
+    layout: Annotated[int, typer.Option(help="Layout index.")] = 0,
+    pose: Annotated[str, typer.Option(help="Grid cell and heading index: I,J,H (H in 0..3).")] = "",
+    output: Annotated[Path, typer.Option("-o", "--output", help="PNG of the view.")] = Path(
+        "view.png"
+    ),
+) -> None:
+    """Render one annotated view; also writes <output>.overlay.png with boxes and relations."""
+    from PIL import Image
+
+    from sgdata.errors import ConfigError
+    from sgdata.overlay import draw_overlay
+    from sgdata.preview import save_png
+    from sgdata.snapshot import render_snapshot
+
+    try:
+        i, j, h = (int(v) for v in pose.split(","))
+    except ValueError:
+        raise ConfigError(f"--pose {pose!r}: expected I,J,H such as 4,6,1") from None
+    record = render_snapshot(room_dir, layout=layout, cell=(i, j), heading=h)
+    overlay_path = output.with_suffix(".overlay.png")
+    save_png(Image.fromarray(record.rgb), output)
+    save_png(draw_overlay(record), overlay_path)
+    counts = np.bincount(record.rel_type, minlength=4) if len(record.rel_type) else [0] * 4
+    console.print(
+        f"wrote {output} and {overlay_path}: {record.num_objects} visible objects, "
+        f"relations on {counts[0]}, in {counts[1]}, proximity {counts[2]}, disjoint {counts[3]}"
+    )
 
 
 main = run_app(app, "sgdata")

@@ -122,7 +122,9 @@ def _parse_class(path: Path, name: str, entry: Any) -> ClassSpec:
         raise CatalogError(f"{where}: expected a table of fields")
     unknown = set(entry) - _FIELDS
     if unknown:
-        raise CatalogError(f"{where}: unknown field {sorted(unknown)[0]!r}; known: {sorted(_FIELDS)}")
+        raise CatalogError(
+            f"{where}: unknown field {sorted(unknown)[0]!r}; known: {sorted(_FIELDS)}"
+        )
     for required in ("dynamics", "shape", "size_min", "size_max", "placement", "palette"):
         if required not in entry:
             raise CatalogError(f"{where}: missing field {required!r}")
@@ -138,7 +140,9 @@ def _parse_class(path: Path, name: str, entry: Any) -> ClassSpec:
         raise CatalogError(f"{where}: field 'size_min' exceeds 'size_max' {size_max}")
     placement = entry["placement"]
     if placement not in PLACEMENTS:
-        raise CatalogError(f"{where}: field 'placement' is {placement!r}; expected one of {PLACEMENTS}")
+        raise CatalogError(
+            f"{where}: field 'placement' is {placement!r}; expected one of {PLACEMENTS}"
+        )
     wall_height = tuple(float(v) for v in entry.get("wall_height", (0.0, 0.0)))
     if len(wall_height) != 2 or wall_height[0] > wall_height[1]:
         raise CatalogError(f"{where}: field 'wall_height' must be [low, high] with low <= high")
@@ -154,7 +158,9 @@ def _parse_class(path: Path, name: str, entry: Any) -> ClassSpec:
         raise CatalogError(f"{where}: field 'variants' must be an integer >= 1")
     palette = entry["palette"]
     if not isinstance(palette, list) or not palette:
-        raise CatalogError(f"{where}: field 'palette' must be a non-empty list of '#rrggbb' colours")
+        raise CatalogError(
+            f"{where}: field 'palette' must be a non-empty list of '#rrggbb' colours"
+        )
     colors = tuple(_hex_color(where, c) for c in palette)
     return ClassSpec(
         name=name,
@@ -177,7 +183,9 @@ def _triple(where: str, key: str, value: Any) -> tuple[float, float, float]:
     ok = isinstance(value, list) and len(value) == 3
     ok = ok and all(isinstance(v, int | float) and v > 0 for v in value)
     if not ok:
-        raise CatalogError(f"{where}: field {key!r} must be 3 positive numbers [width, depth, height]")
+        raise CatalogError(
+            f"{where}: field {key!r} must be 3 positive numbers [width, depth, height]"
+        )
     return (float(value[0]), float(value[1]), float(value[2]))
 
 

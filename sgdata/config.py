@@ -51,7 +51,9 @@ class DatasetConfig:
 
     def __post_init__(self) -> None:
         if not self.name or any(c in self.name for c in "/\\ "):
-            raise ConfigError(f"dataset.name {self.name!r}: expected a non-empty name without spaces or slashes")
+            raise ConfigError(
+                f"dataset.name {self.name!r}: expected a non-empty name without spaces or slashes"
+            )
         if not 0 <= self.seed < 2**63:
             raise ConfigError(f"dataset.seed must be within [0, 2**63), got {self.seed}")
 
@@ -68,7 +70,9 @@ class RoomsConfig:
     def __post_init__(self) -> None:
         unknown = [t for t in self.types if t not in ROOM_TYPES]
         if unknown or not self.types:
-            raise ConfigError(f"rooms.types {list(self.types)}: expected some of {list(ROOM_TYPES)}")
+            raise ConfigError(
+                f"rooms.types {list(self.types)}: expected some of {list(ROOM_TYPES)}"
+            )
         for split in SPLITS:
             if getattr(self, split) < 0:
                 raise ConfigError(f"rooms.{split} must be >= 0")
@@ -88,7 +92,9 @@ class LayoutsConfig:
 
     def __post_init__(self) -> None:
         if self.count < 2:
-            raise ConfigError(f"layouts.count must be >= 2 (tier 0 needs another layout), got {self.count}")
+            raise ConfigError(
+                f"layouts.count must be >= 2 (tier 0 needs another layout), got {self.count}"
+            )
 
 
 @dataclass(frozen=True)
@@ -103,7 +109,9 @@ class PosesConfig:
         if not 0.05 <= self.cell <= 2.0:
             raise ConfigError(f"poses.cell must be within [0.05, 2] m, got {self.cell}")
         if not 0.0 <= self.robot_radius < 1.0:
-            raise ConfigError(f"poses.robot_radius must be within [0, 1) m, got {self.robot_radius}")
+            raise ConfigError(
+                f"poses.robot_radius must be within [0, 1) m, got {self.robot_radius}"
+            )
 
 
 @dataclass(frozen=True)
@@ -115,7 +123,9 @@ class AnnotationConfig:
 
     def __post_init__(self) -> None:
         if self.min_visible_pixels < 1:
-            raise ConfigError(f"annotation.min_visible_pixels must be >= 1, got {self.min_visible_pixels}")
+            raise ConfigError(
+                f"annotation.min_visible_pixels must be >= 1, got {self.min_visible_pixels}"
+            )
 
 
 @dataclass(frozen=True)
@@ -132,7 +142,9 @@ class TripletsConfig:
             if getattr(self, split) < 0:
                 raise ConfigError(f"triplets.{split} must be >= 0")
         if len(self.shares) != 5 or abs(sum(self.shares) - 1.0) > 1e-9 or min(self.shares) < 0:
-            raise ConfigError(f"triplets.shares {list(self.shares)}: expected 5 shares summing to 1")
+            raise ConfigError(
+                f"triplets.shares {list(self.shares)}: expected 5 shares summing to 1"
+            )
 
     def per_split(self) -> dict[str, int]:
         """Triplets in each split."""
@@ -150,7 +162,9 @@ class ImagesConfig:
         if self.format not in ("png", "jpeg"):
             raise ConfigError(f"images.format {self.format!r}: expected 'png' or 'jpeg'")
         if not 1 <= self.jpeg_quality <= 100:
-            raise ConfigError(f"images.jpeg_quality must be within [1, 100], got {self.jpeg_quality}")
+            raise ConfigError(
+                f"images.jpeg_quality must be within [1, 100], got {self.jpeg_quality}"
+            )
 
 
 @dataclass(frozen=True)
@@ -255,4 +269,3 @@ def _convert(hint: Any, value: Any, key: str) -> Any:
             raise ConfigError(f"key {key!r}: expected {hint.__name__}, got {value!r}")
         return value
     return value
-

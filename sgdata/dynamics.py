@@ -21,8 +21,8 @@ import numpy as np
 
 from .catalog import Catalog
 from .errors import ConfigError
-from .poses import pose_grid
 from .placement import WorldSurface, colliding, inside_room, place_on_surface, world_surfaces
+from .poses import pose_grid
 from .rooms import door_keepout
 from .scene import Dynamics, Placement, Room, SceneObject
 from .seeds import derive_seed, rng_for
@@ -78,9 +78,8 @@ class DynamicsConfig:
         if self.yaw_sigma_deg < 0:
             raise ConfigError(f"dynamics.yaw_sigma_deg must be >= 0, got {self.yaw_sigma_deg}")
         if not 0.0 <= self.min_reachable_share <= 1.0:
-            raise ConfigError(
-                f"dynamics.min_reachable_share must be within [0, 1], got {self.min_reachable_share}"
-            )
+            share = self.min_reachable_share
+            raise ConfigError(f"dynamics.min_reachable_share must be within [0, 1], got {share}")
         if self.tries < 1:
             raise ConfigError(f"dynamics.tries must be >= 1, got {self.tries}")
         for cls, override in self.classes.items():
@@ -222,14 +221,25 @@ class _LayoutSampler:
         return room, [moves[k] for k in sorted(moves)]
 
     def _record(
-        self, moves: dict[int, Move], before: SceneObject, after: SceneObject, rule: str, moved: bool
+        self,
+        moves: dict[int, Move],
+        before: SceneObject,
+        after: SceneObject,
+        rule: str,
+        moved: bool,
     ) -> None:
         # "before" is always the base arrangement, even for an object carried earlier
         original = self.base_objects[before.instance]
         earlier = moves.get(before.instance)
         moves[before.instance] = Move(
-            before.instance, before.class_name, rule, original.placement, after.placement,
-            original.support, after.support, moved or (earlier.moved if earlier else False),
+            before.instance,
+            before.class_name,
+            rule,
+            original.placement,
+            after.placement,
+            original.support,
+            after.support,
+            moved or (earlier.moved if earlier else False),
         )
 
     def _record_carried(self, moves: dict[int, Move], room: Room) -> None:
@@ -238,8 +248,14 @@ class _LayoutSampler:
             if obj.instance in moves or obj.placement == original.placement:
                 continue
             moves[obj.instance] = Move(
-                obj.instance, obj.class_name, "carried", original.placement, obj.placement,
-                original.support, obj.support, True,
+                obj.instance,
+                obj.class_name,
+                "carried",
+                original.placement,
+                obj.placement,
+                original.support,
+                obj.support,
+                True,
             )
 
     def _descendants(self, instance: int) -> list[int]:
@@ -293,15 +309,22 @@ class _LayoutSampler:
                 return False
         return True
 
-    def _low_candidate(self, obj: SceneObject, moving: set[int]) -> tuple[Placement, int | None] | None:
+    def _low_candidate(
+        self, obj: SceneObject, moving: set[int]
+    ) -> tuple[Placement, int | None] | None:
         radius = self.config.radius(obj)
         distance = radius * math.sqrt(self.rng.random())  # uniform over the disk
         angle = self.rng.uniform(-math.pi, math.pi)
         sigma = self.config.yaw_sigma(obj)
-        yaw_noise = float(np.clip(self.rng.normal(0.0, sigma), -3 * sigma, 3 * sigma)) if sigma else 0.0
+        yaw_noise = (
+            float(np.clip(self.rng.normal(0.0, sigma), -3 * sigma, 3 * sigma)) if sigma else 0.0
+        )
         p = obj.placement
         placement = Placement(
-            p.x + distance * math.cos(angle), p.y + distance * math.sin(angle), p.z, p.yaw + yaw_noise
+            p.x + distance * math.cos(angle),
+            p.y + distance * math.sin(angle),
+            p.z,
+            p.yaw + yaw_noise,
         )
         if obj.support is not None:
             support = self.objects[obj.support]
@@ -309,14 +332,20 @@ class _LayoutSampler:
                 return None
         return placement, obj.support
 
-    def _high_candidate(self, obj: SceneObject, moving: set[int]) -> tuple[Placement, int | None] | None:
+    def _high_candidate(
+        self, obj: SceneObject, moving: set[int]
+    ) -> tuple[Placement, int | None] | None:
         spec = self.catalog[obj.class_name]
         yaw = float(self.rng.uniform(-math.pi, math.pi))
         if spec.placement in ("floor", "wall_floor") and obj.support is None:
             room = self.base
             half = bounding_radius(obj)
-            x = float(self.rng.uniform(min(half, room.width / 2), max(room.width - half, room.width / 2)))
-            y = float(self.rng.uniform(min(half, room.depth / 2), max(room.depth - half, room.depth / 2)))
+            x = float(
+                self.rng.uniform(min(half, room.width / 2), max(room.width - half, room.width / 2))
+            )
+            y = float(
+                self.rng.uniform(min(half, room.depth / 2), max(room.depth - half, room.depth / 2))
+            )
             return Placement(x, y, obj.placement.z, yaw), None
         surfaces = self._surfaces_for(obj, moving)
         if not surfaces:

@@ -136,13 +136,22 @@ def colliding(
     """The first object in ``others`` that ``candidate`` interpenetrates, ignoring its own
     support chain and everything resting on or attached to it."""
     mine = ancestors(candidate, by_instance)
-    for other in others:
-        if other.instance == candidate.instance or other.instance in mine:
-            continue
-        if candidate.instance in ancestors(other, by_instance):
-            continue
-        if boxes_overlap(candidate, other):
-            return other
+    pool = [
+        o
+        for o in others
+        if o.instance != candidate.instance
+        and o.instance not in mine
+        and candidate.instance not in ancestors(o, by_instance)
+    ]
+    if not pool:
+        return None
+    # axis-aligned prefilter over all objects at once; the oriented test decides the rest
+    corners = np.stack([o.corners() for o in pool])
+    own = candidate.corners()
+    overlap = (corners.min(axis=1) < own.max(axis=0)) & (corners.max(axis=1) > own.min(axis=0))
+    for index in np.nonzero(overlap.all(axis=1))[0]:
+        if boxes_overlap(candidate, pool[index]):
+            return pool[index]
     return None
 
 

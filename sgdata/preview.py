@@ -24,7 +24,9 @@ def _font(size: int) -> ImageFont.ImageFont:
     return ImageFont.load_default(size=size)
 
 
-def draw_room(room: Room, *, moved: set[int] | None = None, title: str | None = None) -> Image.Image:
+def draw_room(
+    room: Room, *, moved: set[int] | None = None, title: str | None = None
+) -> Image.Image:
     """A top-down drawing of ``room``: footprints filled with object colours, labels, door.
 
     Objects in ``moved`` are outlined in red. Objects are drawn from the floor up, so what
@@ -42,7 +44,9 @@ def draw_room(room: Room, *, moved: set[int] | None = None, title: str | None = 
         return MARGIN + x * scale, 24 + MARGIN + (room.depth - y) * scale
 
     corners = [to_px(0, 0), to_px(room.width, room.depth)]
-    draw.rectangle([corners[0][0], corners[1][1], corners[1][0], corners[0][1]], outline=WALL_COLOR, width=4)
+    draw.rectangle(
+        [corners[0][0], corners[1][1], corners[1][0], corners[0][1]], outline=WALL_COLOR, width=4
+    )
     _draw_door(draw, room, to_px)
     font = _font(11)
     labels: list[tuple[tuple[float, float], str, bool]] = []
@@ -50,15 +54,22 @@ def draw_room(room: Room, *, moved: set[int] | None = None, title: str | None = 
         polygon = [to_px(*c[:2]) for c in _footprint(obj)]
         fill = tuple(int(255 * c) for c in obj.color)
         is_moved = obj.instance in moved
-        draw.polygon(polygon, fill=fill, outline=MOVED_COLOR if is_moved else (30, 30, 30),
-                     width=3 if is_moved else 1)
+        draw.polygon(
+            polygon,
+            fill=fill,
+            outline=MOVED_COLOR if is_moved else (30, 30, 30),
+            width=3 if is_moved else 1,
+        )
         if obj.attached_to is None:
             labels.append((to_px(obj.placement.x, obj.placement.y), obj.class_name, is_moved))
     for (x, y), text, is_moved in labels:
         box = draw.textbbox((x, y), text, font=font, anchor="mm")
         draw.rectangle(box, fill=(255, 255, 255))
         draw.text((x, y), text, fill=MOVED_COLOR if is_moved else (0, 0, 0), font=font, anchor="mm")
-    heading = title or f"{room.room_id}  {room.width:.2f} x {room.depth:.2f} m  {len(room.objects)} objects"
+    heading = (
+        title
+        or f"{room.room_id}  {room.width:.2f} x {room.depth:.2f} m  {len(room.objects)} objects"
+    )
     draw.text((MARGIN, 8), heading, fill=(0, 0, 0), font=_font(15))
     return image
 
@@ -69,7 +80,9 @@ def draw_layout_pair(base: Room, layout: Room, *, title: str = "layout") -> Imag
     moved = {o.instance for o in layout.objects if before.get(o.instance) != o.placement}
     left = draw_room(base, title=f"{base.room_id}  base layout")
     right = draw_room(layout, moved=moved, title=f"{base.room_id}  {title}: {len(moved)} moved")
-    pair = Image.new("RGB", (left.width + right.width + 10, max(left.height, right.height)), "white")
+    pair = Image.new(
+        "RGB", (left.width + right.width + 10, max(left.height, right.height)), "white"
+    )
     pair.paste(left, (0, 0))
     pair.paste(right, (left.width + 10, 0))
     return pair

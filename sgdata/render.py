@@ -1,7 +1,11 @@
 """Offscreen renderer: RGB (pyrender over EGL) and exact per-pixel instance ids for one room.
 
-The RGB pass is pyrender's forward pass with one mesh node per object, so a new layout of the
-same room only moves nodes (:meth:`Renderer.update_poses`) and never rebuilds meshes.
+The RGB pass draws the room's structure and all objects merged into one world-space mesh:
+on llvmpipe pyrender's per-node Python overhead (uniforms and lights bound per primitive)
+cost more than the rasterising itself, and merging took a 68-object kitchen from 8 to 20 RGB
+frames/s. A new layout of the same room (:meth:`Renderer.update_poses`) re-merges the kept
+object meshes under the new transforms (numpy only, no recipe or USD work) and moves the
+object nodes of the id scene; only a different instance set rebuilds everything.
 
 Instance ids come from one of two id passes (``id_pass``), both exact (no blended values):
 
@@ -15,9 +19,9 @@ Instance ids come from one of two id passes (``id_pass``), both exact (no blende
   pixel (the rasteriser's sample point) and a lookup table maps the hit triangle to its
   object: integers all the way.
 
-Measured on 2 llvmpipe cores, 224², the 7-object test room with walls (``bench/render.py
---synthetic``): raster 66-70 ids/s, raycast 47-57 ids/s (rays that all hit something are
-slower than open3d's ~130-140/s on sparse scenes), RGB 12-17 fps; hence raster by default.
+Measured on 2 llvmpipe cores, 224², a generated 68-object kitchen: raster 20 ids/s, raycast
+15 ids/s (one thread; rays that all hit something are slower than open3d's ~140/s on sparse
+scenes), hence raster by default (see docs/benchmarks.md).
 The two agree except on pixels whose centre lies exactly on a shared edge.
 
 EGL: ``PYOPENGL_PLATFORM`` is set to ``egl`` (unless the caller already set it) by
@@ -41,7 +45,7 @@ from typing import Any, Literal
 import numpy as np
 
 from .errors import RenderError
-from .meshes import MeshData, SceneGeometry
+from .meshes import MeshData, ObjectGeometry, SceneGeometry
 
 __all__ = ["CameraConfig", "RenderedView", "Renderer", "use_egl_platform"]
 
@@ -190,6 +194,7 @@ class Renderer:
         self._meshes: list[MeshData] = []
         self._structure: tuple[MeshData, ...] = ()
         self._scene: Any = None
+        self._merged_node: Any = None
         self._seg_map: dict[Any, np.ndarray] = {}
         self._instance_lut = np.full(1, -1, dtype=np.int32)  # dense index + 1 -> instance
         self._rays_cam = self._camera_rays()
@@ -205,38 +210,25 @@ class Renderer:
         return self._instances or ()
 
     def load(self, scene: SceneGeometry) -> None:
-        """Build the pyrender scene (one node per object and per structure mesh)."""
+        """Build the scenes of a room: the RGB scene draws structure and all objects merged
+        into one world-space mesh (pyrender's per-node overhead dominates on llvmpipe), the
+        id scene keeps one node per object for the SEG pass."""
         pr = self._pr
-        sc = pr.Scene(bg_color=[0.0, 0.0, 0.0, 1.0], ambient_light=[self.ambient] * 3)
-        self._structure = scene.structure
-        struct_nodes = [
-            sc.add(pr.Mesh([_primitive(pr, m, double_sided=True)])) for m in scene.structure
-        ]
-        self._object_nodes, self._meshes = [], []
-        for obj in scene.objects:
-            node = sc.add(pr.Mesh([_primitive(pr, obj.mesh)]), pose=np.asarray(obj.matrix))
-            self._object_nodes.append(node)
-            self._meshes.append(obj.mesh)
         n = len(scene.objects)
         if n + 1 >= _SEG_LIMIT:
             raise RenderError(
                 f"{n} objects in one scene: the id pass encodes at most {_SEG_LIMIT - 2}"
             )
+        self._structure = scene.structure
+        self._meshes = [obj.mesh for obj in scene.objects]
+        self._matrices = [np.asarray(o.matrix) for o in scene.objects]
         self._instances = tuple(int(o.instance) for o in scene.objects)
         self._instance_lut = np.array((-1, *self._instances), dtype=np.int32)
-        zero = np.zeros(3, dtype=np.int64)
-        self._seg_map = {node: zero for node in struct_nodes}
-        for k, node in enumerate(self._object_nodes):
-            code = k + 1
-            self._seg_map[node] = np.array([code & 255, (code >> 8) & 255, code >> 16])
-        self._cam_node = sc.add(
-            pr.PerspectiveCamera(
-                yfov=self.camera.yfov,
-                aspectRatio=self.camera.width / self.camera.height,
-                znear=self.camera.znear,
-                zfar=self.camera.zfar,
-            )
-        )
+        sc = pr.Scene(bg_color=[0.0, 0.0, 0.0, 1.0], ambient_light=[self.ambient] * 3)
+        for m in scene.structure:
+            sc.add(pr.Mesh([_primitive(pr, m, double_sided=True)]))
+        self._merged_node = sc.add(pr.Mesh([_primitive(pr, _merged_world(scene.objects))]))
+        self._cam_node = sc.add(self._camera_model())
         # Key light rides with the camera (faces towards the viewer always read), fill light
         # comes from above at a slant so tops and fronts of boxes differ in shade.
         self._key = pr.DirectionalLight(color=np.ones(3), intensity=self.key_intensity)
@@ -245,15 +237,26 @@ class Renderer:
         fill_pose = np.eye(4)
         fill_pose[:3, :3] = _look_rotation(np.array([0.3, 0.5, -1.0]))
         sc.add(self._fill, pose=fill_pose)
+        # One node per object for the SEG pass, hidden during the RGB pass. Both live in the
+        # one scene: pyrender unloads the GPU buffers of meshes absent from the scene it draws,
+        # so alternating two scenes would re-upload everything every view.
+        zero = np.zeros(3, dtype=np.int64)
+        self._seg_map = {node: zero for node in sc.mesh_nodes if node is not self._merged_node}
+        self._object_nodes = []
+        for code, (mesh, matrix) in enumerate(zip(self._meshes, self._matrices, strict=True), 1):
+            node = sc.add(pr.Mesh([_primitive(pr, mesh)]), pose=matrix)
+            node.mesh.is_visible = False
+            self._object_nodes.append(node)
+            self._seg_map[node] = np.array([code & 255, (code >> 8) & 255, code >> 16])
         self._scene = sc
         self._rc = None  # built on the first raycast id pass
-        self._matrices = [np.asarray(o.matrix) for o in scene.objects]
 
     def update_poses(self, scene: SceneGeometry) -> bool:
         """Move the loaded objects to a new layout of the same room.
 
-        Returns ``False`` when only node poses changed, ``True`` when the instance set (or a
-        mesh) differed and the scene was rebuilt.
+        Returns ``False`` when only poses changed (the merged RGB mesh is re-merged from the
+        kept meshes, object nodes of the id scene are moved), ``True`` when the instance set
+        (or a mesh) differed and the scenes were rebuilt.
         """
         same = (
             self._scene is not None
@@ -265,11 +268,23 @@ class Renderer:
         if not same:
             self.load(scene)
             return True
-        for node, obj in zip(self._object_nodes, scene.objects, strict=True):
-            self._scene.set_pose(node, np.asarray(obj.matrix))
         self._matrices = [np.asarray(o.matrix) for o in scene.objects]
+        self._scene.remove_node(self._merged_node)
+        self._merged_node = self._scene.add(
+            self._pr.Mesh([_primitive(self._pr, _merged_world(scene.objects))])
+        )
+        for node, matrix in zip(self._object_nodes, self._matrices, strict=True):
+            self._scene.set_pose(node, matrix)
         self._rc = None  # rebuilt lazily with the new world vertices
         return False
+
+    def _camera_model(self) -> Any:
+        return self._pr.PerspectiveCamera(
+            yfov=self.camera.yfov,
+            aspectRatio=self.camera.width / self.camera.height,
+            znear=self.camera.znear,
+            zfar=self.camera.zfar,
+        )
 
     # -- rendering --------------------------------------------------------------------------
 
@@ -349,14 +364,22 @@ class Renderer:
 
     def _raster_index(self, x: float, y: float, theta: float) -> np.ndarray:
         self._scene.set_pose(self._cam_node, self.camera.pose_matrix(x, y, theta))
-        color, _ = self._gl.render(
-            self._scene, flags=self._pr.RenderFlags.SEG, seg_node_map=self._seg_map
-        )
+        self._show_object_nodes(True)
+        try:
+            color, _ = self._gl.render(
+                self._scene, flags=self._pr.RenderFlags.SEG, seg_node_map=self._seg_map
+            )
+        finally:
+            self._show_object_nodes(False)
         c = color.astype(np.int32)
         code = c[..., 0] | (c[..., 1] << 8) | (c[..., 2] << 16)
         if int(code.max()) >= len(self._instance_lut):
             raise RenderError("id pass returned an unknown colour code (blended ids?)")
         return code
+
+    def _show_object_nodes(self, visible: bool) -> None:
+        for node in self._object_nodes:
+            node.mesh.is_visible = visible
 
     def _camera_rays(self) -> np.ndarray:
         """Per-pixel ray directions through pixel centres in (right, up, forward) coords."""
@@ -405,6 +428,18 @@ class Renderer:
         prim = hit["primitive_ids"].numpy().astype(np.int64)
         prim[prim >= len(self._face_owner) - 1] = len(self._face_owner) - 1  # misses
         return self._face_owner[prim].reshape(cam.height, cam.width)
+
+
+def _merged_world(objects: tuple[ObjectGeometry, ...]) -> MeshData:
+    """All objects' meshes moved into world space and concatenated into one mesh."""
+    if not objects:
+        return MeshData(np.zeros((0, 3)), np.zeros((0, 3), np.int32), np.zeros((0, 3), np.float32))
+    counts = np.cumsum([0] + [len(o.mesh.vertices) for o in objects[:-1]])
+    return MeshData(
+        np.concatenate([o.world_vertices() for o in objects]),
+        np.concatenate([o.mesh.faces + k for o, k in zip(objects, counts, strict=True)]),
+        np.concatenate([o.mesh.face_colors for o in objects]),
+    )
 
 
 def _same_mesh(a: MeshData, b: MeshData) -> bool:

@@ -89,10 +89,14 @@ def _parse(path: str, room_type: str, entry: dict[str, Any], catalog: Catalog) -
         items = []
         for item in entry.get(key, []):
             if not isinstance(item, dict) or "class" not in item:
-                raise CatalogError(f"{where}: field {key!r} needs entries like {{class = ..., count = [1, 2]}}")
+                raise CatalogError(
+                    f"{where}: field {key!r} needs entries like {{class = ..., count = [1, 2]}}"
+                )
             count = item.get("count", [1, 1])
             if not (isinstance(count, list) and len(count) == 2 and 0 <= count[0] <= count[1]):
-                raise CatalogError(f"{where}: field {key!r}: class {item['class']}: count must be [low, high]")
+                raise CatalogError(
+                    f"{where}: field {key!r}: class {item['class']}: count must be [low, high]"
+                )
             near = item.get("near")
             above = item.get("above")
             items.append(

@@ -64,7 +64,9 @@ def generate_room(
         ConfigError: unknown room type or negative index.
     """
     if room_type not in ROOM_TYPES:
-        raise ConfigError(f"unknown room type {room_type!r}; expected one of {', '.join(ROOM_TYPES)}")
+        raise ConfigError(
+            f"unknown room type {room_type!r}; expected one of {', '.join(ROOM_TYPES)}"
+        )
     if index < 0:
         raise ConfigError(f"room index must be >= 0, got {index}")
     catalog = catalog or load_catalog()
@@ -157,7 +159,10 @@ class _RoomBuilder:
         if not inside_room(candidate, self.room):
             return False
         others = [*self.objects, self.keepout]
-        return colliding(candidate, others, {**self.by_instance, candidate.instance: candidate}) is None
+        return (
+            colliding(candidate, others, {**self.by_instance, candidate.instance: candidate})
+            is None
+        )
 
     def _commit(self, obj: SceneObject) -> None:
         """Add an object and, recursively, the attached parts its recipe brings."""
@@ -168,7 +173,9 @@ class _RoomBuilder:
         for part in object_build(obj, self.catalog).attachments:
             spec = self.catalog[part.class_name]
             world = matrix @ np.array([part.x, part.y, part.z, 1.0])
-            placement = Placement(float(world[0]), float(world[1]), float(world[2]), owner_yaw + part.yaw)
+            placement = Placement(
+                float(world[0]), float(world[1]), float(world[2]), owner_yaw + part.yaw
+            )
             child = SceneObject(
                 instance=len(self.objects) + 1,
                 class_name=spec.name,
@@ -234,7 +241,9 @@ class _RoomBuilder:
             while cursor + size[0] <= length:
                 along = cursor + size[0] / 2
                 along = length - along if reverse else along
-                candidate = self._new(spec, size, wall_placement(self.room, wall, along, size[1], 0.0))
+                candidate = self._new(
+                    spec, size, wall_placement(self.room, wall, along, size[1], 0.0)
+                )
                 if self._fits(candidate):
                     placed = candidate
                     break
@@ -307,7 +316,9 @@ class _RoomBuilder:
                 z = max(z, anchor.world_aabb()[1][2] + 0.1)
             else:
                 wall = WALLS[int(self.rng.integers(len(WALLS)))]
-                along = self._uniform(size[0] / 2 + 0.05, self.room.wall_length(wall) - size[0] / 2 - 0.05)
+                along = self._uniform(
+                    size[0] / 2 + 0.05, self.room.wall_length(wall) - size[0] / 2 - 0.05
+                )
             if z + size[2] > self.room.height - 0.05:
                 continue
             candidate = self._new(spec, size, wall_placement(self.room, wall, along, size[1], z))
@@ -327,7 +338,9 @@ class _RoomBuilder:
         for _ in range(SURFACE_TRIES):
             target = surfaces[int(self.rng.integers(len(surfaces)))]
             size = self._size(spec)
-            yaw = None if spec.dynamics is Dynamics.HIGH else int(self.rng.integers(4)) * math.pi / 2
+            yaw = (
+                None if spec.dynamics is Dynamics.HIGH else int(self.rng.integers(4)) * math.pi / 2
+            )
             placement = place_on_surface(self.rng, target, size, yaw=yaw)
             if placement is None:
                 continue

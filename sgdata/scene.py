@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 from enum import StrEnum
+from functools import cached_property
 
 import numpy as np
 
@@ -91,9 +92,16 @@ class SceneObject:
         return np.array([-w / 2, -d / 2, 0.0]), np.array([w / 2, d / 2, h])
 
     def corners(self) -> np.ndarray:
-        """The 8 world corners of the object's oriented bounding box, shape (8, 3)."""
+        """The 8 world corners of the object's oriented bounding box, shape (8, 3), read-only."""
+        return self._corners
+
+    @cached_property
+    def _corners(self) -> np.ndarray:
+        # cached: placement checks ask for the corners of every object many times
         lo, hi = self.local_box()
-        return box_corners(lo, hi, self.placement.matrix())
+        corners = box_corners(lo, hi, self.placement.matrix())
+        corners.flags.writeable = False
+        return corners
 
     def world_aabb(self) -> tuple[np.ndarray, np.ndarray]:
         """World axis-aligned box (min, max) around the oriented box."""

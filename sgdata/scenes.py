@@ -68,9 +68,13 @@ def load_base(room_dir: Path) -> Room:
         ConfigError: ``room_dir`` is not a room directory.
     """
     if not room_dir.is_dir():
-        raise ConfigError(f"{room_dir}: not a directory; expected a room directory holding {ROOM_FILE}")
+        raise ConfigError(
+            f"{room_dir}: not a directory; expected a room directory holding {ROOM_FILE}"
+        )
     if not room_file(room_dir).is_file():
-        raise ConfigError(f"{room_dir}: no {ROOM_FILE}; expected a directory written by 'sgdata rooms'")
+        raise ConfigError(
+            f"{room_dir}: no {ROOM_FILE}; expected a directory written by 'sgdata rooms'"
+        )
     return read_room(room_file(room_dir))
 
 
@@ -135,4 +139,3 @@ def load_layout(room_dir: Path, index: int, catalog: Catalog | None = None) -> R
     if problems:
         raise SceneError(f"{path}: invalid layout: {problems[0]}")
     return room
-

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .catalog import Catalog
-from .placement import CONTACT_EPS, boxes_overlap, ancestors, inside_room, world_surfaces
+from .placement import CONTACT_EPS, ancestors, boxes_overlap, inside_room, world_surfaces
 from .scene import Room, SceneObject
 
 __all__ = ["room_problems", "resting_surface"]
@@ -42,9 +42,10 @@ def room_problems(room: Room, catalog: Catalog, *, limit: int = 20) -> list[str]
     for obj in objects:
         if not inside_room(obj, room):
             lo, hi = obj.world_aabb()
+            shell = f"{room.width:.2f} x {room.depth:.2f} x {room.height:.2f}"
             problems.append(
                 f"{obj.prim_name} is not inside the room (box {np.round(lo, 2).tolist()} .. "
-                f"{np.round(hi, 2).tolist()}, room {room.width:.2f} x {room.depth:.2f} x {room.height:.2f})"
+                f"{np.round(hi, 2).tolist()}, room {shell})"
             )
         for key in (obj.support, obj.attached_to):
             if key is not None and key not in by_instance:

@@ -35,7 +35,10 @@ def test_rooms_layouts_preview(tmp_path: Path) -> None:
     assert result.returncode == 0, result.stderr
     assert "% moved" in result.stdout
     assert sorted(p.name for p in room_dir.iterdir()) == [
-        "layout_0.usda", "layout_1.usda", "layout_2.usda", "room.usda"
+        "layout_0.usda",
+        "layout_1.usda",
+        "layout_2.usda",
+        "room.usda",
     ]
     png = tmp_path / "top.png"
     result = run("preview", str(room_dir / "layout_2.usda"), "--compare", "-o", str(png))

@@ -44,7 +44,8 @@ def test_low_dynamic_moves_within_radius_on_same_support(twenty, kitchen: Room) 
             assert move.displacement <= config.radius_factor * bounding_radius(obj) + 1e-9
             assert move.support_after == move.support_before
             yaw_change = math.atan2(
-                math.sin(move.after.yaw - move.before.yaw), math.cos(move.after.yaw - move.before.yaw)
+                math.sin(move.after.yaw - move.before.yaw),
+                math.cos(move.after.yaw - move.before.yaw),
             )
             assert abs(math.degrees(yaw_change)) <= 3 * config.yaw_sigma_deg + 1e-6
     assert moved > 0
@@ -61,9 +62,7 @@ def test_high_dynamic_objects_spread(twenty, kitchen: Room) -> None:
         if o.instance == chairs[0]
     }
     assert len(spots) >= 4
-    supports = {
-        layout.room.by_instance()[mugs[0]].support for layout in twenty
-    }
+    supports = {layout.room.by_instance()[mugs[0]].support for layout in twenty}
     assert len(supports) >= 2
 
 
@@ -134,7 +133,9 @@ def test_bad_input(tmp_path: Path, kitchen_dir: Path, catalog: Catalog) -> None:
         read_room(orphan / "layout_1.usda")
 
 
-def test_layer_edited_into_a_wall_is_refused(tmp_path: Path, kitchen_dir: Path, catalog: Catalog) -> None:
+def test_layer_edited_into_a_wall_is_refused(
+    tmp_path: Path, kitchen_dir: Path, catalog: Catalog
+) -> None:
     copy = tmp_path / "kitchen_000"
     shutil.copytree(kitchen_dir, copy)
     room = read_room(copy / "room.usda")

@@ -123,7 +123,10 @@ def test_real_meshes_do_not_interpenetrate(
             related = _attached_lineage(a, by_instance) | _attached_lineage(b, by_instance)
             if b.instance in related or a.instance in related:
                 continue
-            if b.instance in ancestors(a, by_instance) and b.class_name in catalog[a.class_name].containers:
+            if (
+                b.instance in ancestors(a, by_instance)
+                and b.class_name in catalog[a.class_name].containers
+            ):
                 continue
             inside = _inside_any(parts[b.instance], points[near])
             if inside.mean() > 0.02:
@@ -138,7 +141,10 @@ def test_usd_round_trip(tmp_path: Path, catalog: Catalog) -> None:
     assert [o.instance for o in back.objects] == [o.instance for o in room.objects]
     for a, b in zip(room.objects, back.objects, strict=True):
         assert (a.class_name, a.support, a.attached_to, a.variant) == (
-            b.class_name, b.support, b.attached_to, b.variant
+            b.class_name,
+            b.support,
+            b.attached_to,
+            b.variant,
         )
         assert np.allclose(a.placement.matrix(), b.placement.matrix(), atol=1e-6)
         assert np.allclose(a.size, b.size, atol=1e-6)
