@@ -105,6 +105,56 @@ def preview(
 
 
 @app.command()
+def generate(
+    config: Annotated[
+        str, typer.Argument(help="Config TOML file, or a preset: tiny | small | paper.")
+    ],
+    out: Annotated[Path, typer.Argument(help="Dataset root directory.")],
+    workers: Annotated[int, typer.Option(help="Worker processes (one renderer each).")] = 1,
+    resume: Annotated[bool, typer.Option(help="Continue an interrupted run in OUT.")] = False,
+    force: Annotated[bool, typer.Option(help="Overwrite what a previous run left in OUT.")] = False,
+) -> None:
+    """Generate a dataset: rooms, layouts, rendered views, cascaded triplets, Parquet."""
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from sgdata.config import load_config
+    from sgdata.generate import generate_dataset
+
+    settings = load_config(config)
+    columns = (
+        TextColumn("{task.description:<7}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TextColumn("rooms  {task.fields[rate]}"),
+        TimeElapsedColumn(),
+    )
+    with Progress(*columns, console=console, transient=False) as bar:
+        phases: dict[str, int] = {}
+
+        def show(step) -> None:  # noqa: ANN001
+            if step.phase not in phases:
+                phases[step.phase] = bar.add_task(step.phase, total=step.total, rate="")
+            rate = f"{step.views / step.elapsed:.1f} views/s" if step.views else ""
+            bar.update(phases[step.phase], completed=step.done, rate=rate)
+
+        manifest = generate_dataset(
+            settings, out, workers=workers, resume=resume, force=force, progress=show
+        )
+    counts = manifest["counts"]
+    table = Table(title=f"{manifest['name']} {manifest['version']} in {out}")
+    for column in ("split", "rooms", "observations", "triplets"):
+        table.add_column(column, justify="left" if column == "split" else "right")
+    for split, rooms in manifest["splits"].items():
+        table.add_row(
+            split,
+            str(len(rooms)),
+            str(counts["observations"][split]),
+            str(counts["triplets"][split]),
+        )
+    console.print(table)
+
+
+@app.command()
 def render(
     room_dir: Annotated[Path, typer.Argument(help="A room directory with its layouts.")],
     layout: Annotated[int, typer.Option(help="Layout index.")] = 0,

@@ -224,7 +224,8 @@ class Renderer:
         self._matrices = [np.asarray(o.matrix) for o in scene.objects]
         self._instances = tuple(int(o.instance) for o in scene.objects)
         self._instance_lut = np.array((-1, *self._instances), dtype=np.int32)
-        sc = pr.Scene(bg_color=[0.0, 0.0, 0.0, 1.0], ambient_light=[self.ambient] * 3)
+        # a dim hallway grey behind the door gap rather than a black hole
+        sc = pr.Scene(bg_color=[0.45, 0.45, 0.48, 1.0], ambient_light=[self.ambient] * 3)
         for m in scene.structure:
             sc.add(pr.Mesh([_primitive(pr, m, double_sided=True)]))
         self._merged_node = sc.add(pr.Mesh([_primitive(pr, _merged_world(scene.objects))]))

@@ -15,6 +15,7 @@ from .errors import CatalogError
 __all__ = ["ROOM_TYPES", "CountedClass", "RoomRecipe", "load_room_recipes"]
 
 ROOM_TYPES = ("kitchen", "living_room", "bedroom", "bathroom")
+SIDES = ("any", "front", "sides")
 
 
 @dataclass(frozen=True)
@@ -25,6 +26,7 @@ class CountedClass:
     count: tuple[int, int]  # inclusive range
     near: str | None = None  # furniture: stand beside (and face) an instance of this class
     above: str | None = None  # wall items: hang above an instance of this class
+    side: str = "any"  # with `near`: which side of the anchor (any | front | sides)
 
 
 @dataclass(frozen=True)
@@ -99,12 +101,18 @@ def _parse(path: str, room_type: str, entry: dict[str, Any], catalog: Catalog) -
                 )
             near = item.get("near")
             above = item.get("above")
+            side = item.get("side", "any")
+            if side not in SIDES:
+                raise CatalogError(
+                    f"{where}: field {key!r}: class {item['class']}: side must be one of {SIDES}"
+                )
             items.append(
                 CountedClass(
                     class_name=known(item["class"], key),
                     count=(int(count[0]), int(count[1])),
                     near=known(near, key) if near is not None else None,
                     above=known(above, key) if above is not None else None,
+                    side=side,
                 )
             )
         return tuple(items)

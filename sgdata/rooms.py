@@ -267,7 +267,7 @@ class _RoomBuilder:
             size = self._size(spec)
             if anchors:
                 anchor = anchors[int(self.rng.integers(len(anchors)))]
-                placement = self._beside(anchor, size)
+                placement = self._beside(anchor, size, item.side)
             elif spec.placement == "wall_floor":
                 wall = WALLS[int(self.rng.integers(len(WALLS)))]
                 along = self._uniform(size[0] / 2, self.room.wall_length(wall) - size[0] / 2)
@@ -288,11 +288,14 @@ class _RoomBuilder:
             yaw = int(self.rng.integers(4)) * math.pi / 2 + self._uniform(-0.05, 0.05)
         return Placement(x, y, 0.0, yaw)
 
-    def _beside(self, anchor: SceneObject, size: tuple[float, float, float]) -> Placement:
-        """A spot next to one side of ``anchor``, facing it."""
+    def _beside(
+        self, anchor: SceneObject, size: tuple[float, float, float], where: str
+    ) -> Placement:
+        """A spot next to one side of ``anchor``: facing it, or beside it facing the same way."""
         aw, ad, _ = anchor.size
-        side = int(self.rng.integers(4))
-        gap = self._uniform(0.02, 0.25)
+        choices = {"any": (0, 1, 2, 3), "front": (0,), "sides": (1, 3)}[where]
+        side = choices[int(self.rng.integers(len(choices)))]
+        gap = self._uniform(0.02, 0.45 if where == "front" else 0.25)
         # side normals in the anchor frame: front (-y), right (+x), back (+y), left (-x)
         nx, ny = [(0, -1), (1, 0), (0, 1), (-1, 0)][side]
         reach = (ad if ny else aw) / 2 + size[1] / 2 + gap
@@ -301,7 +304,10 @@ class _RoomBuilder:
         lx, ly = nx * reach + (offset if ny else 0.0), ny * reach + (offset if nx else 0.0)
         world = anchor.placement.matrix() @ np.array([lx, ly, 0.0, 1.0])
         dx, dy = anchor.placement.x - world[0], anchor.placement.y - world[1]
-        yaw = math.atan2(dy, dx) + math.pi / 2  # front (-Y local) towards the anchor
+        if where == "sides":  # a night stand or side table stands square with its anchor
+            yaw = anchor.placement.yaw
+        else:
+            yaw = math.atan2(dy, dx) + math.pi / 2  # front (-Y local) towards the anchor
         return Placement(float(world[0]), float(world[1]), 0.0, yaw)
 
     def _place_wall_item(self, spec: ClassSpec, item: CountedClass) -> None:

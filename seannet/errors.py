@@ -1,0 +1,21 @@
+"""The SeanNet error hierarchy: every user-facing failure is a SeannetError with a one-line message."""
+
+from __future__ import annotations
+
+__all__ = ["SeannetError", "ModelError", "CheckpointError", "DataError"]
+
+
+class SeannetError(Exception):
+    """Base of every error the CLI reports as one line instead of a traceback."""
+
+
+class ModelError(SeannetError):
+    """A model cannot be built: a bad hyper-parameter, or pretrained weights that do not fit."""
+
+
+class CheckpointError(SeannetError):
+    """A training checkpoint is missing, malformed or from an incompatible model."""
+
+
+class DataError(SeannetError):
+    """Model input is malformed: a batch, a dataset record or the word-vector table."""

@@ -1,0 +1,182 @@
+"""The multi-pathway GCN (SeanNet paper §IV-C): one GCN pathway per relation type."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import torch
+from torch import Tensor, nn
+
+from ..errors import ModelError
+
+__all__ = ["GCNLayer", "GCNPathway", "MultiPathwayGCN"]
+
+
+class GCNLayer(nn.Module):
+    r"""One graph-convolution layer on a given normalised adjacency (Kipf & Welling,
+    https://arxiv.org/abs/1609.02907), batched over graphs:
+
+    .. math::
+        X' = \hat{A} X W
+
+    :math:`\hat{A}` is used as given (row-normalised by the data pipeline; no self-loops
+    are added here). There is no bias by default: a node with a zero row in :math:`\hat{A}`
+    (an empty slot) then gets a zero output, so empty slots stay zero through a pathway and the
+    flattened pathway output depends on present nodes only.
+
+    Args:
+        in_dim: input node-feature width.
+        out_dim: output node-feature width.
+        bias: add a learned bias (default ``False``, see above).
+
+    Shapes:
+        - **x**: :math:`(B, M, F_{in})` node features
+        - **adjacency**: :math:`(B, M, M)` normalised adjacency :math:`\hat{A}`
+        - **output**: :math:`(B, M, F_{out})`
+    """
+
+    def __init__(self, in_dim: int, out_dim: int, *, bias: bool = False) -> None:
+        super().__init__()
+        if in_dim <= 0 or out_dim <= 0:
+            raise ModelError(f"GCNLayer({in_dim}, {out_dim}): widths must be positive")
+        self.in_dim = in_dim
+        self.out_dim = out_dim
+        self.weight = nn.Parameter(torch.empty(in_dim, out_dim))
+        self.bias = nn.Parameter(torch.empty(out_dim)) if bias else None
+        self.reset_parameters()
+
+    def reset_parameters(self) -> None:
+        # Glorot uniform, as in Kipf & Welling's reference implementation
+        nn.init.xavier_uniform_(self.weight)
+        if self.bias is not None:
+            nn.init.zeros_(self.bias)
+
+    def forward(self, x: Tensor, adjacency: Tensor) -> Tensor:
+        # (A X) W or A (X W): multiply by W first, it shrinks the width (512 -> 256 -> 64 -> 8)
+        out = adjacency @ (x @ self.weight)
+        if self.bias is not None:
+            out = out + self.bias
+        return out
+
+    def extra_repr(self) -> str:
+        return f"{self.in_dim}, {self.out_dim}, bias={self.bias is not None}"
+
+
+class GCNPathway(nn.Module):
+    r"""A stack of GCN layers on one relation's adjacency :math:`\hat{A}_r`:
+
+    .. math::
+        X_r^{(i)} = \mathrm{ReLU}(\hat{A}_r\, \mathrm{Dropout}(X_r^{(i-1)})\, W^{(i)}),
+        \quad i = 1 \dots L
+
+    Dropout is applied to each layer's input, as in Kipf & Welling's GCN.
+
+    Args:
+        dims: node widths from input to output (default (512, 256, 64, 8): 3 layers).
+        dropout: dropout probability (default 0.2, paper §V-B).
+
+    Shapes:
+        - **x**: :math:`(B, M, \text{dims}[0])`
+        - **adjacency**: :math:`(B, M, M)`
+        - **output**: :math:`(B, M, \text{dims}[-1])`
+    """
+
+    def __init__(self, dims: Sequence[int] = (512, 256, 64, 8), *, dropout: float = 0.2) -> None:
+        super().__init__()
+        dims = tuple(int(d) for d in dims)
+        if len(dims) < 2:
+            raise ModelError(f"GCN pathway dims={dims}; expected at least (in, out)")
+        if not 0.0 <= dropout < 1.0:
+            raise ModelError(f"dropout={dropout}; expected 0 <= dropout < 1")
+        self.dims = dims
+        self.layers = nn.ModuleList(GCNLayer(a, b) for a, b in zip(dims[:-1], dims[1:]))
+        self.dropout = nn.Dropout(dropout)
+
+    def reset_parameters(self) -> None:
+        for layer in self.layers:
+            layer.reset_parameters()
+
+    def forward(self, x: Tensor, adjacency: Tensor) -> Tensor:
+        for layer in self.layers:
+            x = torch.relu(layer(self.dropout(x), adjacency))
+        return x
+
+
+class MultiPathwayGCN(nn.Module):
+    r"""The scene-graph branch of SeanNet (https://arxiv.org/abs/2110.02276, §IV-C, Fig. 3).
+
+    One :class:`GCNPathway` per relation type r (on, in, proximity; 'disjoint' carries no
+    information and is dropped), each on its own :math:`\hat{A}_r` and the shared
+    :math:`X^{(0)}`. The M × 8 outputs are flattened (M·8 = 2048 for M = 256), concatenated
+    (6144) and mapped by an fcn to the scene-graph embedding:
+
+    .. math::
+        g = \mathrm{ReLU}(W_2\, \mathrm{ReLU}(W_1 [\mathrm{vec}(X_{on});
+            \mathrm{vec}(X_{in}); \mathrm{vec}(X_{prox})] + b_1) + b_2)
+
+    Flattening keeps the slot order, so position in the vector means class (DESIGN §8).
+
+    Args:
+        num_slots: M, node slots per graph (default 256).
+        dims: pathway widths (default (512, 256, 64, 8)).
+        num_relations: pathways (default 3).
+        hidden_dim: width of the fcn's hidden layer (default 4096).
+        out_dim: width of the scene-graph embedding (default 2048).
+        dropout: GCN dropout (default 0.2).
+
+    Shapes:
+        - **x**: :math:`(B, M, \text{dims}[0])` node features :math:`X^{(0)}`
+        - **adjacency**: :math:`(B, R, M, M)`, R = ``num_relations``
+        - **output**: :math:`(B, \text{out\_dim})`
+    """
+
+    def __init__(
+        self,
+        num_slots: int = 256,
+        dims: Sequence[int] = (512, 256, 64, 8),
+        *,
+        num_relations: int = 3,
+        hidden_dim: int = 4096,
+        out_dim: int = 2048,
+        dropout: float = 0.2,
+    ) -> None:
+        super().__init__()
+        for name, value in (
+            ("num_slots", num_slots),
+            ("num_relations", num_relations),
+            ("hidden_dim", hidden_dim),
+            ("out_dim", out_dim),
+        ):
+            if value <= 0:
+                raise ModelError(f"{name}={value}; expected a positive integer")
+        self.num_slots = num_slots
+        self.num_relations = num_relations
+        self.pathways = nn.ModuleList(
+            GCNPathway(dims, dropout=dropout) for _ in range(num_relations)
+        )
+        flat = num_relations * num_slots * self.pathways[0].dims[-1]
+        self.fc = nn.Sequential(
+            nn.Linear(flat, hidden_dim),
+            nn.ReLU(inplace=True),
+            nn.Linear(hidden_dim, out_dim),
+            nn.ReLU(inplace=True),
+        )
+        self.out_dim = out_dim
+
+    def reset_parameters(self) -> None:
+        for p in self.pathways:
+            p.reset_parameters()
+        for m in self.fc:
+            if isinstance(m, nn.Linear):
+                m.reset_parameters()
+
+    def forward(self, x: Tensor, adjacency: Tensor) -> Tensor:
+        b, r, m = adjacency.shape[0], adjacency.shape[1], adjacency.shape[-1]
+        if r != self.num_relations or m != self.num_slots or x.shape[:2] != (b, m):
+            raise ModelError(
+                f"GCN input x {tuple(x.shape)}, adjacency {tuple(adjacency.shape)}; expected "
+                f"(B, {self.num_slots}, F) and (B, {self.num_relations}, "
+                f"{self.num_slots}, {self.num_slots})"
+            )
+        flat = [p(x, adjacency[:, i]).flatten(1) for i, p in enumerate(self.pathways)]
+        return self.fc(torch.cat(flat, dim=1))

@@ -1,0 +1,131 @@
+"""Loading ``--pretrained PATH``: a local torchvision state_dict file, checked by SHA-256.
+
+Nothing here downloads. The file is accepted when its SHA-256 equals (or, for a short hex
+prefix of at least 8 digits, starts with) the digest the user gave, or — when none is given —
+when it starts with the digest prefix torchvision publishes in the file name of its ImageNet
+weights for that architecture (the same check ``torch.hub`` makes with ``check_hash=True``).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import re
+from collections.abc import Mapping
+from pathlib import Path
+
+import torch
+from torch import Tensor, nn
+
+from .errors import ModelError
+
+__all__ = ["KNOWN_WEIGHTS", "file_sha256", "load_state_dict_file", "load_pretrained"]
+
+# torchvision's ImageNet weight files: architecture -> {file name: sha256 prefix}. The prefix
+# is the one torchvision embeds in the file name (torchvision 0.29 model URLs).
+KNOWN_WEIGHTS: dict[str, dict[str, str]] = {
+    "resnet18": {"resnet18-f37072fd.pth": "f37072fd"},
+    "resnet34": {"resnet34-b627a593.pth": "b627a593"},
+    "resnet50": {"resnet50-0676ba61.pth": "0676ba61", "resnet50-11ad3fa6.pth": "11ad3fa6"},
+    "resnext50": {
+        "resnext50_32x4d-7cdf4587.pth": "7cdf4587",
+        "resnext50_32x4d-1a0047aa.pth": "1a0047aa",
+    },
+    "vgg16": {"vgg16-397923af.pth": "397923af"},
+    "googlenet": {"googlenet-1378be20.pth": "1378be20"},
+}
+
+_HEX = re.compile(r"[0-9a-f]{8,64}")
+
+
+def file_sha256(path: Path) -> str:
+    """Hex SHA-256 of a file, read in 1 MiB chunks."""
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for chunk in iter(lambda: f.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def _check_hash(path: Path, actual: str, arch: str, sha256: str | None) -> None:
+    if sha256 is not None:
+        expected = sha256.strip().lower()
+        if not _HEX.fullmatch(expected):
+            raise ModelError(
+                f"pretrained sha256 {sha256!r} is not 8 to 64 hex digits; give the file's "
+                f"sha256 (`sha256sum {path}`)"
+            )
+        if not actual.startswith(expected):
+            raise ModelError(
+                f"pretrained weights {path}: sha256 mismatch: expected {expected}, actual "
+                f"{actual}; the file is corrupt or not the one meant"
+            )
+        return
+    known = KNOWN_WEIGHTS.get(arch, {})
+    if any(actual.startswith(prefix) for prefix in known.values()):
+        return
+    names = ", ".join(known) or "none"
+    raise ModelError(
+        f"pretrained weights {path}: sha256 {actual} matches no known {arch} weights "
+        f"(known: {names}); pass its sha256 explicitly if you trust the file"
+    )
+
+
+def load_state_dict_file(path: Path, *, arch: str, sha256: str | None = None) -> dict[str, Tensor]:
+    """Read a torchvision-format state_dict after checking its SHA-256.
+
+    Args:
+        path: a local ``.pth`` file holding a ``{name: tensor}`` mapping.
+        arch: architecture key of :data:`KNOWN_WEIGHTS`, used when ``sha256`` is ``None``.
+        sha256: the expected digest (64 hex digits, or a prefix of at least 8).
+
+    Raises:
+        ModelError: missing file, hash mismatch or unknown hash, or not a state_dict.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise ModelError(f"pretrained weights {path}: no such file")
+    _check_hash(path, file_sha256(path), arch, sha256)
+    try:
+        # weights_only: never unpickle arbitrary objects from a weights file
+        obj = torch.load(path, map_location="cpu", weights_only=True)
+    except Exception as exc:  # noqa: BLE001 - any load failure means "not a state_dict"
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise ModelError(
+            f"pretrained weights {path}: not a torch state_dict file ({first[:200]})"
+        ) from None
+    if (
+        not isinstance(obj, Mapping)
+        or not obj
+        or not all(isinstance(k, str) and isinstance(v, Tensor) for k, v in obj.items())
+    ):
+        raise ModelError(
+            f"pretrained weights {path}: holds a {type(obj).__name__}, not a state_dict "
+            f"(a non-empty mapping of parameter names to tensors)"
+        )
+    return dict(obj)
+
+
+def load_pretrained(
+    model: nn.Module, path: Path, *, arch: str, sha256: str | None = None
+) -> nn.Module:
+    """Load a checked torchvision state_dict into ``model`` (strictly) and return it.
+
+    Raises:
+        ModelError: as :func:`load_state_dict_file`, or keys / shapes that do not fit.
+    """
+    state = load_state_dict_file(path, arch=arch, sha256=sha256)
+    own = model.state_dict()
+    missing = sorted(set(own) - set(state))
+    unexpected = sorted(set(state) - set(own))
+    wrong = sorted(k for k in set(own) & set(state) if own[k].shape != state[k].shape)
+    if missing or unexpected or wrong:
+        parts = []
+        for label, keys in (("missing", missing), ("unexpected", unexpected), ("shape", wrong)):
+            if keys:
+                parts.append(f"{len(keys)} {label} (e.g. {keys[0]})")
+        raise ModelError(
+            f"pretrained weights {path} do not fit {arch}: {', '.join(parts)}; "
+            f"give the torchvision {arch} weights"
+        )
+    model.load_state_dict(state, strict=True)
+    return model

@@ -1,0 +1,92 @@
+"""The on-disk dataset: path layout, row building and Parquet writing, manifest, reader.
+
+Writer side (used by ``sgdata generate``): :func:`observation_table`, :func:`triplet_table`,
+:func:`write_parquet`, :class:`Manifest`, :func:`write_manifest`. Reader side:
+:class:`Dataset`. The format itself is described in docs/dataset.md.
+"""
+
+from ..schema import FORMAT_VERSION, manifest_json_schema, observations_schema, triplets_schema
+from .layout import (
+    MANIFEST,
+    OBSERVATIONS,
+    SCENE_LAYER,
+    SCENE_ROOM,
+    SCENES,
+    SPLITS,
+    TRIPLETS,
+    ObsKey,
+    obs_id,
+    observations_path,
+    parse_obs_id,
+    scene_layer_path,
+    triplets_path,
+)
+from .manifest import (
+    MIGRATIONS,
+    ClassEntry,
+    Counts,
+    FileEntry,
+    FormatVersionError,
+    Generator,
+    ImageInfo,
+    Manifest,
+    check_compatible,
+    classes_from_slots,
+    file_entry,
+    migrate_manifest_dict,
+    read_manifest,
+    relation_type_names,
+    write_manifest,
+)
+from .reader import Dataset, decode_image
+from .rows import (
+    ParquetInfo,
+    encode_image,
+    observation_table,
+    sha256_file,
+    triplet_table,
+    write_parquet,
+)
+
+__all__ = [
+    "FORMAT_VERSION",
+    "MANIFEST",
+    "MIGRATIONS",
+    "OBSERVATIONS",
+    "SCENES",
+    "SCENE_LAYER",
+    "SCENE_ROOM",
+    "SPLITS",
+    "TRIPLETS",
+    "ClassEntry",
+    "Counts",
+    "Dataset",
+    "FileEntry",
+    "FormatVersionError",
+    "Generator",
+    "ImageInfo",
+    "Manifest",
+    "ObsKey",
+    "ParquetInfo",
+    "check_compatible",
+    "classes_from_slots",
+    "decode_image",
+    "encode_image",
+    "file_entry",
+    "manifest_json_schema",
+    "migrate_manifest_dict",
+    "obs_id",
+    "observation_table",
+    "observations_path",
+    "observations_schema",
+    "parse_obs_id",
+    "read_manifest",
+    "relation_type_names",
+    "scene_layer_path",
+    "sha256_file",
+    "triplet_table",
+    "triplets_path",
+    "triplets_schema",
+    "write_manifest",
+    "write_parquet",
+]

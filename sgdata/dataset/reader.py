@@ -1,0 +1,186 @@
+"""Reading a dataset directory: the manifest, the observation shards and the triplet tables.
+
+Only pyarrow, numpy and Pillow: the PyTorch data loader builds on this. The files themselves
+need no sgdata code at all (see docs/dataset.md for pyarrow, polars, DuckDB and ``datasets``).
+"""
+
+from __future__ import annotations
+
+import io
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+from PIL import Image
+
+from ..errors import DatasetError
+from ..schema import observations_schema, triplets_schema
+from .layout import MANIFEST, observations_path, triplets_path
+from .manifest import Manifest, read_manifest
+from .rows import sha256_file
+
+__all__ = ["Dataset", "decode_image"]
+
+
+def decode_image(data: bytes) -> np.ndarray:
+    """An ``(H, W, 3)`` uint8 array from encoded PNG or JPEG bytes (an ``image`` cell).
+
+    Raises:
+        DatasetError: the bytes are not a readable image.
+    """
+    try:
+        with Image.open(io.BytesIO(data)) as image:
+            return np.asarray(image.convert("RGB"))
+    except (OSError, ValueError) as exc:
+        raise DatasetError(
+            f"image bytes ({len(data)} B) are not a readable PNG/JPEG: {exc}"
+        ) from None
+
+
+class Dataset:
+    """An sgdata dataset on disk; open it with :meth:`Dataset.open`.
+
+    Tables come back as ``pyarrow.Table`` with the schemas of :mod:`sgdata.schema`; convert
+    with ``.to_pandas()`` or ``polars.from_arrow`` as needed.
+    """
+
+    def __init__(self, root: Path, manifest: Manifest) -> None:
+        self._root = Path(root)
+        self._manifest = manifest
+
+    @classmethod
+    def open(cls, root: str | Path) -> Dataset:
+        """Read and validate ``root/dataset.json`` (format version check included).
+
+        Raises:
+            DatasetError: no manifest (unfinished generation or not a dataset), an invalid
+                one, or one of a format this sgdata cannot read (``FormatVersionError``).
+        """
+        root = Path(root)
+        if not root.is_dir():
+            raise DatasetError(f"{root}: no such directory; expected an sgdata dataset root")
+        return cls(root, read_manifest(root))
+
+    def __repr__(self) -> str:
+        m = self._manifest
+        counts = ", ".join(f"{s}={n}" for s, n in m.counts.observations.items())
+        return f"Dataset({str(self._root)!r}, name={m.name!r}, observations: {counts})"
+
+    # ------------------------------------------------------------------ metadata
+
+    @property
+    def root(self) -> Path:
+        """The dataset directory."""
+        return self._root
+
+    @property
+    def manifest(self) -> Manifest:
+        """The validated ``dataset.json``."""
+        return self._manifest
+
+    @property
+    def splits(self) -> list[str]:
+        """Split names present, in train/val/test order."""
+        return list(self._manifest.to_dict()["splits"])
+
+    def rooms(self, split: str) -> list[str]:
+        """Room ids of ``split`` in storage order."""
+        return list(self._split(split))
+
+    @property
+    def class_names(self) -> list[str]:
+        """Class names in id order (``objects[].class_id`` indexes this)."""
+        return [c.name for c in self._manifest.classes]
+
+    @property
+    def slot_runs(self) -> dict[str, tuple[int, int]]:
+        """Class name -> (first GCN slot, run length)."""
+        return self._manifest.slot_runs
+
+    @property
+    def relation_types(self) -> list[str]:
+        """Relation names (``relations[].type`` indexes this)."""
+        return list(self._manifest.relation_types)
+
+    def _split(self, split: str) -> tuple[str, ...]:
+        try:
+            return self._manifest.splits[split]
+        except KeyError:
+            raise DatasetError(
+                f"split {split!r} is not in {self._root / MANIFEST}; "
+                f"it holds: {', '.join(self.splits) or 'none'}"
+            ) from None
+
+    # ------------------------------------------------------------------ tables
+
+    def observation_files(self, split: str) -> list[Path]:
+        """The observation shards of ``split``, one per room, in manifest room order."""
+        return [self._root / observations_path(split, room) for room in self._split(split)]
+
+    def _read(self, path: Path, columns: Sequence[str] | None, schema: pa.Schema) -> pa.Table:
+        if not path.is_file():
+            raise DatasetError(
+                f"{path}: listed by {MANIFEST} but missing; the dataset is incomplete "
+                "(copy it again, or run sgdata generate --resume)"
+            )
+        try:
+            table = pq.read_table(path, columns=list(columns) if columns is not None else None)
+        except (pa.ArrowException, OSError) as exc:
+            raise DatasetError(f"{path}: not a readable Parquet file ({exc})") from None
+        expected = schema if columns is None else pa.schema([schema.field(c) for c in columns])
+        if not table.schema.equals(expected):
+            raise DatasetError(
+                f"{path}: columns do not match the format {self._manifest.format_version} "
+                f"schema; expected {expected.names}, found {table.schema.names}"
+            )
+        return table
+
+    def observations(self, split: str, *, columns: Sequence[str] | None = None) -> pa.Table:
+        """All observation rows of ``split`` (its room shards concatenated in room order).
+
+        Args:
+            columns: read only these columns (e.g. leave out ``image`` for metadata scans).
+        """
+        schema = observations_schema()
+        if columns is not None:
+            unknown = [c for c in columns if c not in schema.names]
+            if unknown:
+                raise DatasetError(f"unknown observation columns {unknown}; known: {schema.names}")
+        tables = [self._read(p, columns, schema) for p in self.observation_files(split)]
+        if not tables:
+            names = schema.names if columns is None else list(columns)
+            return pa.schema([schema.field(n) for n in names]).empty_table()
+        return pa.concat_tables(tables)
+
+    def triplets(self, split: str) -> pa.Table:
+        """The triplets of ``split`` (``triplet_id`` is the row index)."""
+        self._split(split)
+        return self._read(self._root / triplets_path(split), None, triplets_schema())
+
+    # ------------------------------------------------------------------ images and checks
+
+    @staticmethod
+    def read_image(data: bytes) -> np.ndarray:
+        """Decode one ``image`` cell: see :func:`decode_image`."""
+        return decode_image(data)
+
+    def verify(self, *, checksums: bool = True) -> list[str]:
+        """Problems with the files the manifest lists: missing, wrong size, wrong sha256.
+
+        Returns an empty list for a sound dataset (nothing is raised).
+        """
+        problems = []
+        for entry in self._manifest.files:
+            path = self._root / entry.path
+            if not path.is_file():
+                problems.append(f"{entry.path}: missing")
+                continue
+            if path.stat().st_size != entry.bytes:
+                problems.append(
+                    f"{entry.path}: {path.stat().st_size} bytes, expected {entry.bytes}"
+                )
+            elif checksums and sha256_file(path)[0] != entry.sha256:
+                problems.append(f"{entry.path}: sha256 differs from {MANIFEST}")
+        return problems

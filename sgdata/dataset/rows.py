@@ -1,0 +1,328 @@
+"""Arrow tables from generation records, and their deterministic, atomic Parquet files.
+
+:func:`observation_table` turns a room's :class:`~sgdata.views.ViewRecord` s into rows of
+``observations_schema()``; :func:`triplet_table` turns a split's
+:class:`~sgdata.triplets.Triplet` s into rows of ``triplets_schema()``; :func:`write_parquet`
+writes either so that identical tables give identical bytes (and so identical sha256 in the
+manifest).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import os
+import tempfile
+from collections.abc import Collection, Sequence
+from pathlib import Path
+from typing import NamedTuple
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+from PIL import Image
+
+from ..errors import DatasetError
+from ..schema import observations_schema, triplets_schema
+from ..triplets import Triplet
+from ..views import ViewRecord
+from .layout import SCENE_LAYER, obs_id
+
+__all__ = [
+    "IMAGE_FORMATS",
+    "PARQUET_OPTIONS",
+    "ParquetInfo",
+    "encode_image",
+    "observation_table",
+    "triplet_table",
+    "write_parquet",
+    "sha256_file",
+]
+
+IMAGE_FORMATS = ("png", "jpeg")
+DOMAIN_SYNTHETIC = "synthetic"
+# Fixed writer options: the same table always gives the same bytes (for a given pyarrow).
+# 256 rows per row group keeps random access to one view cheap for data loaders.
+PARQUET_OPTIONS: dict[str, object] = {
+    "compression": "zstd",
+    "compression_level": 3,
+    "row_group_size": 256,
+    "use_dictionary": True,
+    "write_statistics": True,
+    "data_page_version": "2.0",
+}
+_HASH_CHUNK = 1 << 20
+
+
+class ParquetInfo(NamedTuple):
+    """What :func:`write_parquet` wrote: rows, sha256 hex digest, size in bytes."""
+
+    rows: int
+    sha256: str
+    bytes: int
+
+
+def encode_image(rgb: np.ndarray, image_format: str = "png", *, jpeg_quality: int = 92) -> bytes:
+    """Encode an ``(H, W, 3)`` uint8 image deterministically (no metadata, fixed settings)."""
+    if image_format not in IMAGE_FORMATS:
+        raise DatasetError(f"image format {image_format!r}: expected one of {IMAGE_FORMATS}")
+    if rgb.dtype != np.uint8 or rgb.ndim != 3 or rgb.shape[2] != 3:
+        raise DatasetError(f"image of shape {rgb.shape} {rgb.dtype}: expected (H, W, 3) uint8")
+    buffer = io.BytesIO()
+    image = Image.fromarray(np.ascontiguousarray(rgb), mode="RGB")
+    if image_format == "png":
+        image.save(buffer, format="PNG", optimize=False, compress_level=6)
+    else:
+        # 4:2:0 subsampling and no progressive/optimize passes: fixed, widely decodable output.
+        image.save(buffer, format="JPEG", quality=int(jpeg_quality), subsampling=2, optimize=False)
+    return buffer.getvalue()
+
+
+def _check_record(rec: ViewRecord) -> int:
+    k = len(rec.obj_instance)
+    lengths = {
+        "obj_class": len(rec.obj_class),
+        "obj_slot": len(rec.obj_slot),
+        "obj_dynamics": len(rec.obj_dynamics),
+        "obj_box2d": len(rec.obj_box2d),
+        "obj_visible_pixels": len(rec.obj_visible_pixels),
+        "obj_box3d_min": len(rec.obj_box3d_min),
+        "obj_box3d_max": len(rec.obj_box3d_max),
+        "obj_obb": len(rec.obj_obb),
+        "obj_support": len(rec.obj_support),
+    }
+    bad = {name: n for name, n in lengths.items() if n != k}
+    if bad:
+        raise DatasetError(
+            f"view {rec.room_id} layout {rec.layout} ({rec.grid_i}, {rec.grid_j}, {rec.heading}): "
+            f"{k} objects but {bad}; every obj_* column must have one entry per object"
+        )
+    if not len(rec.rel_src) == len(rec.rel_dst) == len(rec.rel_type):
+        raise DatasetError(f"view {rec.room_id}: rel_src, rel_dst, rel_type lengths differ")
+    if rec.rgb.shape[:2] != (rec.image_height, rec.image_width):
+        raise DatasetError(
+            f"view {rec.room_id}: rgb is {rec.rgb.shape[:2]} but the camera says "
+            f"{rec.image_height} x {rec.image_width}"
+        )
+    return k
+
+
+def _fixed(values: np.ndarray, t: pa.DataType, width: int) -> pa.Array:
+    flat = pa.array(np.asarray(values).reshape(-1, width).ravel(), type=t.value_type)
+    return pa.FixedSizeListArray.from_arrays(flat, type=t)
+
+
+def _concat(parts: Sequence[np.ndarray], dtype: type, shape: tuple[int, ...] = ()) -> np.ndarray:
+    if not parts:
+        return np.zeros((0, *shape), dtype=dtype)
+    return np.concatenate([np.asarray(p, dtype=dtype).reshape(-1, *shape) for p in parts])
+
+
+def _offsets(counts: Sequence[int]) -> pa.Array:
+    return pa.array(np.concatenate([[0], np.cumsum(counts, dtype=np.int64)]), type=pa.int32())
+
+
+def _objects_column(
+    records: Sequence[ViewRecord], counts: list[int], class_ids: dict[str, int], t: pa.ListType
+) -> pa.Array:
+    st = t.value_type
+    names = [c for r in records for c in r.obj_class]
+    missing = sorted({c for c in names if c not in class_ids})
+    if missing:
+        raise DatasetError(f"object classes {missing} are not in class_ids (the class vocabulary)")
+    support = _concat([r.obj_support for r in records], np.int64)
+    children = {
+        "instance": pa.array(_concat([r.obj_instance for r in records], np.int32)),
+        "class_name": pa.array(names, type=pa.string()),
+        "class_id": pa.array(np.fromiter((class_ids[c] for c in names), np.int16, len(names))),
+        "slot": pa.array(_concat([r.obj_slot for r in records], np.int16)),
+        "dynamics": pa.array([str(d) for r in records for d in r.obj_dynamics], type=pa.string()),
+        "visible_pixels": pa.array(_concat([r.obj_visible_pixels for r in records], np.int32)),
+        "support": pa.array(support.astype(np.int32), mask=support < 0),
+    }
+    for name, width in (("box2d", 4), ("box3d_min", 3), ("box3d_max", 3), ("obb", 7)):
+        ft = st.field(name).type
+        dtype = np.int16 if pa.types.is_int16(ft.value_type) else np.float32
+        parts = [getattr(r, f"obj_{name}") for r in records]
+        children[name] = _fixed(_concat(parts, dtype, (width,)), ft, width)
+    fields = [st.field(i) for i in range(st.num_fields)]
+    values = pa.StructArray.from_arrays([children[f.name] for f in fields], fields=fields)
+    return pa.ListArray.from_arrays(_offsets(counts), values, type=t)
+
+
+def _relations_column(records: Sequence[ViewRecord], t: pa.ListType) -> pa.Array:
+    st = t.value_type
+    fields = [st.field(i) for i in range(st.num_fields)]
+    values = pa.StructArray.from_arrays(
+        [
+            pa.array(_concat([r.rel_src for r in records], np.int32)),
+            pa.array(_concat([r.rel_dst for r in records], np.int32)),
+            pa.array(_concat([r.rel_type for r in records], np.int8)),
+        ],
+        fields=fields,
+    )
+    return pa.ListArray.from_arrays(_offsets([len(r.rel_src) for r in records]), values, type=t)
+
+
+def observation_table(
+    records: Sequence[ViewRecord],
+    *,
+    room_type: str,
+    split: str,
+    class_ids: dict[str, int],
+    scene_path: str | None = SCENE_LAYER,
+    image_format: str = "png",
+    jpeg_quality: int = 92,
+) -> pa.Table:
+    """Rows of ``observations_schema()`` for the rendered views of one room, in record order.
+
+    Args:
+        records: the room's views (the pipeline passes them sorted by obs id).
+        room_type: ``kitchen``, ``living_room``, ``bedroom`` or ``bathroom``.
+        split: ``train``, ``val`` or ``test``.
+        class_ids: class name -> index in the manifest's class vocabulary.
+        scene_path: template of the ``scene`` column, formatted with ``room_id`` and
+            ``layout`` (default ``scenes/{room_id}/layout_{layout}.usda``); ``None`` for null.
+        image_format: ``png`` (lossless, default) or ``jpeg``.
+        jpeg_quality: JPEG quality, 1..100 (ignored for PNG).
+
+    Raises:
+        DatasetError: inconsistent record columns, an unknown class or image format.
+    """
+    schema = observations_schema()
+    counts = [_check_record(r) for r in records]
+    n = len(records)
+    ids = [obs_id(r.room_id, r.layout, r.grid_i, r.grid_j, r.heading) for r in records]
+    cam_t = schema.field("camera").type
+    camera = pa.StructArray.from_arrays(
+        [
+            pa.array([r.image_width for r in records], type=pa.int16()),
+            pa.array([r.image_height for r in records], type=pa.int16()),
+            pa.array([r.hfov_deg for r in records], type=pa.float32()),
+            pa.array([r.eye_height for r in records], type=pa.float32()),
+            pa.array([r.pitch_deg for r in records], type=pa.float32()),
+        ],
+        fields=[cam_t.field(i) for i in range(cam_t.num_fields)],
+    )
+    scenes = [
+        None if scene_path is None else scene_path.format(room_id=r.room_id, layout=r.layout)
+        for r in records
+    ]
+    columns = {
+        "obs_id": pa.array(ids, type=pa.string()),
+        "room_id": pa.array([r.room_id for r in records], type=pa.string()),
+        "room_type": pa.array([room_type] * n, type=pa.string()),
+        "layout": pa.array([r.layout for r in records], type=pa.int16()),
+        "split": pa.array([split] * n, type=pa.string()),
+        "domain": pa.array([DOMAIN_SYNTHETIC] * n, type=pa.string()),
+        "x": pa.array([r.x for r in records], type=pa.float64()),
+        "y": pa.array([r.y for r in records], type=pa.float64()),
+        "theta": pa.array([r.theta for r in records], type=pa.float64()),
+        "grid_i": pa.array([r.grid_i for r in records], type=pa.int16()),
+        "grid_j": pa.array([r.grid_j for r in records], type=pa.int16()),
+        "heading": pa.array([r.heading for r in records], type=pa.int8()),
+        "camera": camera,
+        "image": pa.array(
+            [encode_image(r.rgb, image_format, jpeg_quality=jpeg_quality) for r in records],
+            type=pa.binary(),
+        ),
+        "image_format": pa.array([image_format] * n, type=pa.string()),
+        "objects": _objects_column(records, counts, class_ids, schema.field("objects").type),
+        "relations": _relations_column(records, schema.field("relations").type),
+        "dropped_objects": pa.array([r.dropped_objects for r in records], type=pa.int16()),
+        "scene": pa.array(scenes, type=pa.string()),
+        "seed": pa.array([r.seed for r in records], type=pa.int64()),
+    }
+    return pa.Table.from_arrays([columns[f.name] for f in schema], schema=schema)
+
+
+def triplet_table(triplets: Sequence[Triplet], obs_ids: Collection[str] | None = None) -> pa.Table:
+    """Rows of ``triplets_schema()`` for one split; ``triplet_id`` is the row index.
+
+    Args:
+        triplets: the split's triplets, in the order they are to be stored.
+        obs_ids: if given, the observation ids present in the split: every anchor, positive
+            and negative must be one of them.
+
+    Raises:
+        DatasetError: triplets of several splits, or a referenced view that is not in
+            ``obs_ids``.
+    """
+    schema = triplets_schema()
+    splits = sorted({t.split for t in triplets})
+    if len(splits) > 1:
+        raise DatasetError(f"triplets of splits {splits} given together; write one split a table")
+
+    def ids(role: str) -> list[str]:
+        keys = ((t.room_id, getattr(t, role)) for t in triplets)
+        return [obs_id(room, p.layout, p.i, p.j, p.heading) for room, p in keys]
+
+    anchors, positives, negatives = ids("anchor"), ids("positive"), ids("negative")
+    if obs_ids is not None:
+        known = obs_ids if isinstance(obs_ids, set | frozenset) else set(obs_ids)
+        missing = sorted({o for o in (*anchors, *positives, *negatives) if o not in known})
+        if missing:
+            raise DatasetError(
+                f"{len(missing)} observation id(s) referenced by triplets are not in the "
+                f"split's observations, e.g. {missing[:3]}; render referenced_poses() first"
+            )
+    off_t = schema.field("positive_offset").type
+    columns = {
+        "triplet_id": pa.array(np.arange(len(triplets), dtype=np.int64)),
+        "split": pa.array([t.split for t in triplets], type=pa.string()),
+        "room_id": pa.array([t.room_id for t in triplets], type=pa.string()),
+        "tier": pa.array([t.tier for t in triplets], type=pa.int8()),
+        "anchor": pa.array(anchors, type=pa.string()),
+        "positive": pa.array(positives, type=pa.string()),
+        "negative": pa.array(negatives, type=pa.string()),
+        "positive_offset": _fixed(
+            np.array([t.positive_offset for t in triplets], np.int8).reshape(-1, 3), off_t, 3
+        ),
+        "negative_offset": _fixed(
+            np.array([t.negative_offset for t in triplets], np.int8).reshape(-1, 3), off_t, 3
+        ),
+    }
+    return pa.Table.from_arrays([columns[f.name] for f in schema], schema=schema)
+
+
+def sha256_file(path: Path) -> tuple[str, int]:
+    """(sha256 hex digest, size in bytes) of a file, read in chunks."""
+    digest, size = hashlib.sha256(), 0
+    with open(path, "rb") as handle:
+        while chunk := handle.read(_HASH_CHUNK):
+            digest.update(chunk)
+            size += len(chunk)
+    return digest.hexdigest(), size
+
+
+def write_parquet(table: pa.Table, path: Path) -> ParquetInfo:
+    """Write ``table`` to ``path`` atomically with :data:`PARQUET_OPTIONS`.
+
+    The file is written to a temporary name in the same directory and renamed over ``path``
+    only once complete, so a reader never sees half a file and a failure leaves none.
+
+    Raises:
+        DatasetError: the directory cannot be created or written, or the table cannot be
+            stored as Parquet.
+    """
+    path = Path(path)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp_name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    except OSError as exc:
+        raise DatasetError(f"{path}: cannot write here ({exc.strerror})") from None
+    tmp = Path(tmp_name)
+    try:
+        with os.fdopen(fd, "wb") as handle:
+            pq.write_table(table, handle, **PARQUET_OPTIONS)
+            handle.flush()
+            os.fsync(handle.fileno())
+        digest, size = sha256_file(tmp)
+        os.replace(tmp, path)
+    except (pa.ArrowException, OSError) as exc:
+        tmp.unlink(missing_ok=True)
+        raise DatasetError(f"{path}: cannot write the table as Parquet ({exc})") from None
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+    return ParquetInfo(rows=table.num_rows, sha256=digest, bytes=size)

@@ -1,0 +1,232 @@
+"""``sgdata generate``: a config in, a versioned Parquet triplet dataset out.
+
+Three phases, each recorded in a ledger under ``<root>/.sgdata/`` so an interrupted run
+resumes without redoing finished work:
+
+1. scenes (per room, in the pool): room + layouts as USD, reachable pose grid per layout;
+2. triplets (per split, in this process): cascaded triplets over the split's rooms, which
+   fixes exactly which views must be rendered;
+3. views (per room, in the pool, one renderer per worker): render and annotate the
+   referenced views, write ``observations/<split>/<room>.parquet`` atomically.
+
+Then the triplet tables and, last, ``dataset.json``. Every random draw derives from the
+config seed and the room / layout / view keys, so the bytes do not depend on the worker count.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from .config import SPLITS, GenerateConfig, config_to_dict
+from .errors import ConfigError, DatasetError
+from .executors import run_tasks
+from .fileio import atomic_write_text, prepare_output_dir
+from .room_recipes import ROOM_TYPES
+from .triplets import PoseKey, RoomPoses, Triplet, sample_triplets
+from .seeds import derive_seed
+
+__all__ = ["RoomTask", "GenerateProgress", "generate_dataset", "plan_rooms"]
+
+LEDGER = ".sgdata"  # progress records of an unfinished (or finished) generation
+_SCENE_RECORD = "scene-{room_id}.json"
+_VIEWS_RECORD = "views-{room_id}.json"
+_CONFIG_RECORD = "config.json"
+
+
+@dataclass(frozen=True)
+class RoomTask:
+    """One room of the dataset: the unit of parallel work."""
+
+    room_type: str
+    index: int
+    split: str
+
+    @property
+    def room_id(self) -> str:
+        return f"{self.room_type}_{self.index:03d}"
+
+
+@dataclass(frozen=True)
+class GenerateProgress:
+    """What a progress callback is told after each finished room of a phase."""
+
+    phase: str  # "scenes" | "views"
+    done: int
+    total: int
+    views: int  # views rendered so far in this run
+    elapsed: float  # seconds since the phase started
+
+
+def plan_rooms(config: GenerateConfig) -> list[RoomTask]:
+    """Rooms of every type, numbered per type: train first, then val, then test."""
+    tasks = []
+    for room_type in ROOM_TYPES:
+        if room_type not in config.rooms.types:
+            continue
+        index = 0
+        for split, count in config.rooms.per_split().items():
+            for _ in range(count):
+                tasks.append(RoomTask(room_type, index, split))
+                index += 1
+    return tasks
+
+
+def generate_dataset(
+    config: GenerateConfig,
+    root: Path,
+    *,
+    workers: int = 1,
+    resume: bool = False,
+    force: bool = False,
+    progress: Callable[[GenerateProgress], None] | None = None,
+) -> dict:
+    """Generate the dataset described by ``config`` into ``root``; returns the manifest dict.
+
+    Raises:
+        ConfigError: ``root`` is a file, holds a finished dataset (without ``force``), holds
+            an unfinished run (without ``resume`` or ``force``), or was started with another
+            config (on ``resume``).
+        DatasetError: a file cannot be written (the run can be resumed once fixed).
+    """
+    if workers < 1:
+        raise ConfigError(f"--workers must be >= 1, got {workers}")
+    _prepare_root(root, config, resume=resume, force=force)
+    tasks = plan_rooms(config)
+    ledger = root / LEDGER
+    scene_jobs = [
+        t for t in tasks if not (ledger / _SCENE_RECORD.format(room_id=t.room_id)).exists()
+    ]
+    _run_phase("scenes", scene_jobs, len(tasks), config, root, workers, progress)
+    grids = {
+        t.room_id: _read_record(ledger / _SCENE_RECORD.format(room_id=t.room_id)) for t in tasks
+    }
+
+    triplets = {split: _split_triplets(config, split, tasks, grids) for split in SPLITS}
+    poses = _poses_by_room(triplets)
+    view_jobs = [
+        (t, poses.get(t.room_id, []))
+        for t in tasks
+        if not (ledger / _VIEWS_RECORD.format(room_id=t.room_id)).exists()
+    ]
+    _run_phase("views", view_jobs, len(tasks), config, root, workers, progress)
+
+    from .dataset.writer import write_manifest, write_triplet_tables
+
+    files = [_read_record(ledger / _VIEWS_RECORD.format(room_id=t.room_id)) for t in tasks]
+    triplet_files = write_triplet_tables(root, triplets)
+    manifest = write_manifest(root, config, tasks, files + triplet_files, triplets)
+    return manifest
+
+
+def _prepare_root(root: Path, config: GenerateConfig, *, resume: bool, force: bool) -> None:
+    from .dataset.layout import MANIFEST
+
+    if root.exists() and not root.is_dir():
+        raise ConfigError(f"{root}: is a file; expected a directory for the dataset")
+    ledger = root / LEDGER
+    if (root / MANIFEST).exists() and not force:
+        raise ConfigError(f"{root}: holds a finished dataset; pass --force to overwrite it")
+    if ledger.exists() and not (resume or force):
+        raise ConfigError(
+            f"{root}: holds an unfinished generation; pass --resume to continue it "
+            "or --force to start over"
+        )
+    if force:
+        _remove_outputs(root)
+    prepare_output_dir(root)
+    record = ledger / _CONFIG_RECORD
+    wanted = json.dumps(config_to_dict(config), sort_keys=True, indent=2)
+    if record.exists():
+        if record.read_text(encoding="utf-8") != wanted:
+            raise ConfigError(
+                f"{root}: was started with another config; rerun with that config "
+                "or pass --force to start over"
+            )
+    else:
+        ledger.mkdir(parents=True, exist_ok=True)
+        atomic_write_text(record, wanted)
+
+
+def _remove_outputs(root: Path) -> None:
+    """Delete what a generation writes (and nothing else the user may keep there)."""
+    from .dataset.layout import MANIFEST
+
+    for name in (MANIFEST, "observations", "triplets", "scenes", LEDGER):
+        target = root / name
+        if target.is_dir():
+            shutil.rmtree(target)
+        elif target.exists():
+            target.unlink()
+
+
+def _run_phase(
+    phase: str,
+    jobs: list,
+    total: int,
+    config: GenerateConfig,
+    root: Path,
+    workers: int,
+    progress: Callable[[GenerateProgress], None] | None,
+) -> None:
+    from .room_work import render_room_views, write_room_scenes
+
+    start = time.perf_counter()
+    done = total - len(jobs)
+    views = 0
+    if phase == "scenes":
+        payloads = [(task, config, root) for task in jobs]
+        fn = write_room_scenes
+    else:
+        payloads = [(task, list(poses), config, root) for task, poses in jobs]
+        fn = render_room_views
+    for result in run_tasks(fn, payloads, workers=workers):
+        done += 1
+        views += int(result.get("views", 0))
+        if progress is not None:
+            progress(GenerateProgress(phase, done, total, views, time.perf_counter() - start))
+
+
+def _read_record(path: Path) -> dict:
+    try:
+        return json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, json.JSONDecodeError) as exc:
+        raise DatasetError(
+            f"{path}: unreadable progress record ({exc}); rerun with --force"
+        ) from None
+
+
+def _split_triplets(
+    config: GenerateConfig, split: str, tasks: list[RoomTask], grids: dict[str, dict]
+) -> list[Triplet]:
+    total = config.triplets.per_split()[split]
+    rooms = [
+        RoomPoses(
+            t.room_id,
+            split,
+            {
+                int(k): frozenset(tuple(c) for c in cells)
+                for k, cells in grids[t.room_id]["reachable"].items()
+            },
+        )
+        for t in tasks
+        if t.split == split
+    ]
+    if total == 0:
+        return []
+    if not rooms:
+        raise ConfigError(f"triplets.{split} = {total} but rooms.{split} = 0: no room to draw from")
+    seed = derive_seed(config.dataset.seed, 1 + SPLITS.index(split))
+    return sample_triplets(rooms, total, seed, shares=config.triplets.shares)
+
+
+def _poses_by_room(triplets: dict[str, list[Triplet]]) -> dict[str, list[PoseKey]]:
+    poses: dict[str, set[PoseKey]] = {}
+    for split_triplets in triplets.values():
+        for t in split_triplets:
+            poses.setdefault(t.room_id, set()).update((t.anchor, t.positive, t.negative))
+    return {room: sorted(keys) for room, keys in poses.items()}
