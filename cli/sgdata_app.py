@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Annotated
 
@@ -110,7 +111,9 @@ def generate(
         str, typer.Argument(help="Config TOML file, or a preset: tiny | small | paper.")
     ],
     out: Annotated[Path, typer.Argument(help="Dataset root directory.")],
-    workers: Annotated[int, typer.Option(help="Worker processes (one renderer each).")] = 1,
+    workers: Annotated[
+        int, typer.Option(help="Worker processes, one renderer each (default: one per core).")
+    ] = 0,
     resume: Annotated[bool, typer.Option(help="Continue an interrupted run in OUT.")] = False,
     force: Annotated[bool, typer.Option(help="Overwrite what a previous run left in OUT.")] = False,
 ) -> None:
@@ -121,6 +124,7 @@ def generate(
     from sgdata.generate import generate_dataset
 
     settings = load_config(config)
+    workers = workers or os.cpu_count() or 1
     columns = (
         TextColumn("{task.description:<7}"),
         BarColumn(),

@@ -53,7 +53,12 @@ class SceneBatch:
             if t.dtype != torch.long:
                 raise DataError(f"{name}: dtype {t.dtype}; expected torch.long")
         a = self.adjacency
-        if a.dim() != 4 or a.shape[0] != b or a.shape[1] != NUM_RELATIONS or a.shape[2] != a.shape[3]:
+        if (
+            a.dim() != 4
+            or a.shape[0] != b
+            or a.shape[1] != NUM_RELATIONS
+            or a.shape[2] != a.shape[3]
+        ):
             raise DataError(
                 f"adjacency: shape {tuple(a.shape)}; expected ({b}, {NUM_RELATIONS}, M, M)"
             )

@@ -1,4 +1,4 @@
-"""The SeanNet error hierarchy: every user-facing failure is a SeannetError with a one-line message."""
+"""The SeanNet error hierarchy: each user-facing failure is a one-line SeannetError."""
 
 from __future__ import annotations
 

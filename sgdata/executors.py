@@ -1,9 +1,13 @@
-"""Where room tasks run: in this process (one worker) or in a pool of spawned processes.
+"""Where room tasks run: a pool of spawned worker processes, even for one worker.
 
 Workers are spawned, never forked: an EGL context does not survive ``fork`` (DESIGN §9). Each
 worker keeps its renderer alive across the rooms it is given (see :mod:`sgdata.room_work`).
-With several workers each gets an equal share of the cores for Mesa's llvmpipe, which
-otherwise spreads every render over all cores and makes the workers fight.
+
+Every worker rasterises on one llvmpipe thread (``LP_NUM_THREADS=1``, ignored by GPU EGL):
+llvmpipe's output differs in rare edge pixels with its thread count (seen here: one pixel of
+one view in 23), so a fixed count is what makes a dataset byte-identical whatever
+``--workers`` is. Parallelism comes from the workers instead: two single-threaded workers
+render 2.1x the views of one default process on 2 cores (DESIGN §9).
 """
 
 from __future__ import annotations
@@ -22,22 +26,17 @@ def run_tasks(
 ) -> Iterator[dict]:
     """Run ``fn(*payload)`` for every payload; yield results as they finish.
 
-    With ``workers == 1`` everything runs here, in order. A worker's exception (an
-    ``SgdataError`` included) is re-raised here after the pool is shut down, so finished
-    tasks stay recorded and the run can resume.
+    A worker's exception (an ``SgdataError`` included) is re-raised here after the pool is
+    shut down, so finished tasks stay recorded and the run can resume.
     """
     jobs = list(payloads)
-    if workers == 1 or len(jobs) <= 1:
-        for payload in jobs:
-            yield fn(*payload)
+    if not jobs:
         return
-    threads = max(1, (os.cpu_count() or 1) // workers)
     context = multiprocessing.get_context("spawn")
     with ProcessPoolExecutor(
         max_workers=min(workers, len(jobs)),
         mp_context=context,
         initializer=_init_worker,
-        initargs=(threads,),
     ) as pool:
         pending: set[Future[Any]] = {pool.submit(fn, *payload) for payload in jobs}
         try:
@@ -51,6 +50,6 @@ def run_tasks(
             raise
 
 
-def _init_worker(llvmpipe_threads: int) -> None:
+def _init_worker() -> None:
     # Runs first in each spawned worker, before pyrender or Mesa load.
-    os.environ.setdefault("LP_NUM_THREADS", str(llvmpipe_threads))
+    os.environ["LP_NUM_THREADS"] = "1"

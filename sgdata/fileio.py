@@ -8,7 +8,16 @@ from pathlib import Path
 
 from .errors import ConfigError
 
-__all__ = ["atomic_write_bytes", "atomic_write_text", "prepare_output_dir"]
+__all__ = [
+    "TEMP_GLOB",
+    "atomic_write_bytes",
+    "atomic_write_text",
+    "prepare_output_dir",
+    "remove_stale_temps",
+]
+
+# Temporary files of atomic writes: ".<name>.<random>.tmp" beside the target.
+TEMP_GLOB = ".*.tmp"
 
 
 def prepare_output_dir(path: Path) -> Path:
@@ -39,6 +48,14 @@ def atomic_write_bytes(path: Path, data: bytes) -> None:
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def remove_stale_temps(root: Path) -> int:
+    """Delete temporary files a killed writer left under ``root``; returns how many."""
+    stale = [p for p in root.rglob(TEMP_GLOB) if p.is_file()]
+    for path in stale:
+        path.unlink(missing_ok=True)
+    return len(stale)
 
 
 def atomic_write_text(path: Path, text: str) -> None:

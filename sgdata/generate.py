@@ -25,14 +25,15 @@ from pathlib import Path
 from .config import SPLITS, GenerateConfig, config_to_dict
 from .errors import ConfigError, DatasetError
 from .executors import run_tasks
-from .fileio import atomic_write_text, prepare_output_dir
+from .fileio import atomic_write_text, prepare_output_dir, remove_stale_temps
 from .room_recipes import ROOM_TYPES
-from .triplets import PoseKey, RoomPoses, Triplet, sample_triplets
+from .room_work import LEDGER
 from .seeds import derive_seed
+from .triplets import PoseKey, RoomPoses, Triplet, sample_triplets
+from .vocabulary import class_vocabulary
 
 __all__ = ["RoomTask", "GenerateProgress", "generate_dataset", "plan_rooms"]
 
-LEDGER = ".sgdata"  # progress records of an unfinished (or finished) generation
 _SCENE_RECORD = "scene-{room_id}.json"
 _VIEWS_RECORD = "views-{room_id}.json"
 _CONFIG_RECORD = "config.json"
@@ -115,12 +116,72 @@ def generate_dataset(
     ]
     _run_phase("views", view_jobs, len(tasks), config, root, workers, progress)
 
-    from .dataset.writer import write_manifest, write_triplet_tables
+    shards = [_read_record(ledger / _VIEWS_RECORD.format(room_id=t.room_id)) for t in tasks]
+    return _finish(root, config, tasks, shards, triplets)
 
-    files = [_read_record(ledger / _VIEWS_RECORD.format(room_id=t.room_id)) for t in tasks]
-    triplet_files = write_triplet_tables(root, triplets)
-    manifest = write_manifest(root, config, tasks, files + triplet_files, triplets)
-    return manifest
+
+def _finish(
+    root: Path,
+    config: GenerateConfig,
+    tasks: list[RoomTask],
+    shards: list[dict],
+    triplets: dict[str, list[Triplet]],
+) -> dict:
+    """Write the triplet tables, then the manifest (last: its presence means finished)."""
+    from . import __version__
+    from .dataset import (
+        Counts,
+        FileEntry,
+        Generator,
+        ImageInfo,
+        Manifest,
+        file_entry,
+        obs_id,
+        triplet_table,
+        triplets_path,
+        write_manifest,
+        write_parquet,
+    )
+
+    splits = [s for s in SPLITS if any(t.split == s for t in tasks)]
+    files = [FileEntry(r["path"], r["rows"], r["sha256"], r["bytes"]) for r in shards]
+    for split in splits:
+        ids = {
+            obs_id(t.room_id, k.layout, k.i, k.j, k.heading)
+            for t in triplets[split]
+            for k in (t.anchor, t.positive, t.negative)
+        }
+        relative = triplets_path(split)
+        info = write_parquet(triplet_table(triplets[split], ids), root / relative)
+        files.append(FileEntry(relative, info.rows, info.sha256, info.bytes))
+    for task in tasks:
+        for usd in sorted((root / "scenes" / task.room_id).glob("*.usda")):
+            files.append(file_entry(root, usd.relative_to(root).as_posix(), rows=None))
+    slots, classes = class_vocabulary()
+    manifest = Manifest(
+        name=config.dataset.name,
+        version=config.dataset.version,
+        generator=Generator("sgdata", __version__),
+        seed=config.dataset.seed,
+        config=config_to_dict(config),
+        classes=classes,
+        num_slots=slots.num_slots,
+        relation_rules=config.annotation.relations.to_dict(),
+        image=ImageInfo(config.images.format, config.camera.width, config.camera.height),
+        splits={s: tuple(t.room_id for t in tasks if t.split == s) for s in splits},
+        counts=Counts(
+            rooms=len(tasks),
+            observations={
+                s: sum(r["rows"] for r, t in zip(shards, tasks, strict=True) if t.split == s)
+                for s in splits
+            },
+            triplets={s: len(triplets[s]) for s in splits},
+            tiers={s: [sum(t.tier == k for t in triplets[s]) for k in range(5)] for s in splits},
+        ),
+        files=tuple(sorted(files, key=lambda f: f.path)),
+    )
+    write_manifest(manifest, root)
+    return manifest.to_dict()
 
 
 def _prepare_root(root: Path, config: GenerateConfig, *, resume: bool, force: bool) -> None:
@@ -139,6 +200,7 @@ def _prepare_root(root: Path, config: GenerateConfig, *, resume: bool, force: bo
     if force:
         _remove_outputs(root)
     prepare_output_dir(root)
+    remove_stale_temps(root)  # a killed run may have left half-written temporaries
     record = ledger / _CONFIG_RECORD
     wanted = json.dumps(config_to_dict(config), sort_keys=True, indent=2)
     if record.exists():

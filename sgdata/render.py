@@ -39,6 +39,8 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any, Literal
 
@@ -158,7 +160,7 @@ class Renderer:
             exact, see the module docstring.
         ambient: ambient light level (linear, 0..1).
         key_intensity: intensity of the head light that travels with the camera.
-        fill_intensity: intensity of the world-fixed light from above.
+        fill_intensity: intensity of the point light under the ceiling's centre.
 
     Raises:
         RenderError: EGL cannot start (names the packages to install).
@@ -171,7 +173,7 @@ class Renderer:
         id_pass: Literal["raycast", "raster"] = "raster",
         ambient: float = 0.35,
         key_intensity: float = 2.2,
-        fill_intensity: float = 1.6,
+        fill_intensity: float = 5.0,
     ) -> None:
         if id_pass not in ("raycast", "raster"):
             raise RenderError(f"id_pass={id_pass!r}: expected 'raycast' or 'raster'")
@@ -231,13 +233,14 @@ class Renderer:
         self._merged_node = sc.add(pr.Mesh([_primitive(pr, _merged_world(scene.objects))]))
         self._cam_node = sc.add(self._camera_model())
         # Key light rides with the camera (faces towards the viewer always read), fill light
-        # comes from above at a slant so tops and fronts of boxes differ in shade.
+        # hangs under the ceiling's centre so tops and fronts of boxes differ in shade. One
+        # light of each type: pyrender keeps lights in sets and binds them in set order, so
+        # two lights of one type would be summed in an order that varies between processes
+        # (seen: +-1 levels over 769 pixels of a view), breaking byte-identical datasets.
         self._key = pr.DirectionalLight(color=np.ones(3), intensity=self.key_intensity)
         self._key_node = sc.add(self._key)
-        self._fill = pr.DirectionalLight(color=np.ones(3), intensity=self.fill_intensity)
-        fill_pose = np.eye(4)
-        fill_pose[:3, :3] = _look_rotation(np.array([0.3, 0.5, -1.0]))
-        sc.add(self._fill, pose=fill_pose)
+        self._fill = pr.PointLight(color=np.ones(3), intensity=self.fill_intensity)
+        sc.add(self._fill, pose=_ceiling_light_pose(scene))
         # One node per object for the SEG pass, hidden during the RGB pass. Both live in the
         # one scene: pyrender unloads the GPU buffers of meshes absent from the scene it draws,
         # so alternating two scenes would re-upload everything every view.
@@ -314,7 +317,8 @@ class Renderer:
         key_pose = pose.copy()  # tilt the head light 15 deg further down than the view
         key_pose[:3, :3] = pose[:3, :3] @ _rot_x(-math.radians(15.0))
         self._scene.set_pose(self._key_node, key_pose)
-        rgb, depth = self._gl.render(self._scene, flags=self._pr.RenderFlags.NONE)
+        with _multisampling_off():
+            rgb, depth = self._gl.render(self._scene, flags=self._pr.RenderFlags.NONE)
         return np.ascontiguousarray(rgb), depth
 
     def render_ids(
@@ -431,6 +435,34 @@ class Renderer:
         return self._face_owner[prim].reshape(cam.height, cam.width)
 
 
+@contextmanager
+def _multisampling_off() -> Iterator[None]:
+    """Make pyrender's RGB pass disable GL_MULTISAMPLE where it would enable it.
+
+    llvmpipe's multisample path is not deterministic: the same view rendered in fresh
+    processes differed in one edge pixel in 2 of 7 runs, never in 11 runs without it. Byte-
+    identical datasets matter more than anti-aliased edges (the speed is the same, 12 fps).
+    pyrender has no switch for it, so its module's ``glEnable`` is wrapped for the call. The
+    wrapper disables rather than skips: a fresh GL context starts with multisampling on.
+    """
+    import pyrender.renderer as pyrender_renderer
+    from OpenGL.GL import GL_MULTISAMPLE, glDisable
+
+    original = pyrender_renderer.glEnable
+
+    def enable(capability: int) -> None:
+        if capability == GL_MULTISAMPLE:
+            glDisable(GL_MULTISAMPLE)
+        else:
+            original(capability)
+
+    pyrender_renderer.glEnable = enable
+    try:
+        yield
+    finally:
+        pyrender_renderer.glEnable = original
+
+
 def _merged_world(objects: tuple[ObjectGeometry, ...]) -> MeshData:
     """All objects' meshes moved into world space and concatenated into one mesh."""
     if not objects:
@@ -475,6 +507,18 @@ def _primitive(pr: Any, mesh: MeshData, *, double_sided: bool = False) -> Any:
         color_0=np.repeat(colors, 3, axis=0),
         material=material,
     )
+
+
+def _ceiling_light_pose(scene: SceneGeometry) -> np.ndarray:
+    """A pose 0.3 m under the centre of the structure's top (the ceiling)."""
+    pose = np.eye(4)
+    if scene.structure:
+        points = np.concatenate([m.vertices for m in scene.structure])
+        lo, hi = points.min(axis=0), points.max(axis=0)
+        pose[:3, 3] = ((lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, hi[2] - 0.3)
+    else:
+        pose[:3, 3] = (0.0, 0.0, 2.5)
+    return pose
 
 
 def _look_rotation(direction: np.ndarray) -> np.ndarray:

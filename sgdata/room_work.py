@@ -24,7 +24,7 @@ if TYPE_CHECKING:
 
 __all__ = ["write_room_scenes", "render_room_views", "view_seed"]
 
-LEDGER = ".sgdata"
+LEDGER = ".sgdata"  # progress records of a generation: what is done, and with which config
 
 # One renderer per worker process, kept alive across rooms (built on first use).
 _worker: dict[str, Any] = {}
@@ -119,23 +119,23 @@ def _annotator(config: GenerateConfig) -> tuple[Any, dict[str, int]]:
     key = json.dumps([config.camera.__dict__, config.annotation.min_visible_pixels], sort_keys=True)
     if _worker.get("key") != key:
         from .render import Renderer
-        from .slots import SlotTable
         from .views import ViewAnnotator
+        from .vocabulary import class_vocabulary
 
         if "renderer" in _worker:
             _worker["renderer"].close()
-        catalog = load_catalog()
+        slots, classes = class_vocabulary()
         renderer = Renderer(config.camera)
         _worker.update(
             key=key,
             renderer=renderer,
             annotator=ViewAnnotator(
                 renderer,
-                SlotTable.from_catalog(catalog),
+                slots,
                 min_visible_pixels=config.annotation.min_visible_pixels,
                 rules=config.annotation.relations,
             ),
-            class_ids={name: i for i, name in enumerate(catalog.names())},
+            class_ids={c.name: c.id for c in classes},
         )
     return _worker["annotator"], _worker["class_ids"]
 

@@ -1,8 +1,13 @@
 """The on-disk contract's schemas: the JSON table DSL in ``schemas/`` parsed into Arrow.
 
 One version constant, :data:`FORMAT_VERSION`, covers the whole format (both tables and the
-manifest). The writer builds its tables against these schemas and the reader checks files
-against them, so the JSON files in ``schemas/`` (installed as the ``sgdata_schemas`` package)
+manifest), and one check, :func:`check_compatible`, decides what this sgdata reads: the same
+major version (an older minor first passes through :data:`MIGRATIONS`, keyed by the version
+migrated *from*; a newer minor has unknown manifest keys dropped, minors only add). Any other
+major is refused with the command that fixes it.
+
+The writer builds its tables against these schemas and the reader checks files against them,
+so the JSON files in ``schemas/`` (installed as the ``sgdata_schemas`` package)
 are the single source of truth.
 
 The DSL: a table is ``{"name", "format_version", "doc", "fields": [field, ...]}``; a field is
@@ -16,6 +21,9 @@ compares equal to the one written).
 from __future__ import annotations
 
 import json
+import logging
+import re
+from collections.abc import Callable, Mapping
 from functools import cache
 from importlib import resources
 from typing import Any
@@ -26,7 +34,11 @@ from .errors import DatasetError
 
 __all__ = [
     "FORMAT_VERSION",
+    "MIGRATIONS",
     "SCHEMA_PACKAGE",
+    "FormatVersionError",
+    "check_compatible",
+    "migrate_manifest_dict",
     "observations_schema",
     "triplets_schema",
     "manifest_json_schema",
@@ -38,6 +50,12 @@ __all__ = [
 FORMAT_VERSION = "1.0.0"  # semver of the whole on-disk format: tables + dataset.json
 SCHEMA_PACKAGE = "sgdata_schemas"  # the installed name of the repository's `schemas/` folder
 LIST_ELEMENT = "element"  # Parquet's compliant list element name (pyarrow writes it by default)
+UPGRADE_HINT = "upgrade sgdata: pip install -U sgdata"
+# from-version -> function taking the raw manifest dict of that version and returning the dict
+# of the next version (with its format_version set). Empty: 1.0.0 is the first format.
+MIGRATIONS: dict[str, Callable[[dict[str, Any]], dict[str, Any]]] = {}
+_SEMVER = re.compile(r"^(0|[1-9]\d*)\.(0|[1-9]\d*)\.(0|[1-9]\d*)(?:[-+][0-9A-Za-z.+-]+)?$")
+log = logging.getLogger(__name__)
 
 _PRIMITIVES: dict[str, pa.DataType] = {
     "string": pa.string(),
@@ -162,6 +180,92 @@ def manifest_json_schema() -> dict[str, Any]:
     return json.loads(_manifest_json_schema_text())
 
 
+# --------------------------------------------------------------------------- versions
+
+
+class FormatVersionError(DatasetError):
+    """The dataset's ``format_version`` is malformed or not readable by this sgdata."""
+
+
+def _parse_version(version: object) -> tuple[int, int, int]:
+    match = _SEMVER.match(version) if isinstance(version, str) else None
+    if match is None:
+        raise FormatVersionError(
+            f"dataset.json format_version {version!r}: expected a semantic version like "
+            f"{FORMAT_VERSION}; the manifest is corrupt (regenerate the dataset)"
+        )
+    return int(match[1]), int(match[2]), int(match[3])
+
+
+def check_compatible(manifest_version: str, *, current: str | None = None) -> None:
+    """Whether this sgdata reads a dataset of format ``manifest_version``; raises if not.
+
+    ``current`` defaults to :data:`~sgdata.schema.FORMAT_VERSION`.
+
+    Raises:
+        FormatVersionError: malformed version, or another major version than ``current``.
+    """
+    major = _parse_version(manifest_version)[0]
+    ours = _parse_version(current or FORMAT_VERSION)[0]
+    if major > ours:
+        raise FormatVersionError(
+            f"dataset.json format_version {manifest_version} is newer than this sgdata reads "
+            f"({ours}.x); {UPGRADE_HINT}"
+        )
+    if major < ours:
+        raise FormatVersionError(
+            f"dataset.json format_version {manifest_version} is older than this sgdata reads "
+            f"({ours}.x); read it with an older sgdata (pip install 'sgdata<{ours}') or "
+            "regenerate it: sgdata generate"
+        )
+
+
+def migrate_manifest_dict(
+    raw: dict[str, Any],
+    *,
+    current: str | None = None,
+    migrations: Mapping[str, Callable[[dict[str, Any]], dict[str, Any]]] | None = None,
+) -> dict[str, Any]:
+    """``raw`` (a parsed ``dataset.json``) brought to the shape of version ``current``
+    (default :data:`~sgdata.schema.FORMAT_VERSION`).
+
+    Older minors go through ``migrations`` (default :data:`MIGRATIONS`) step by step; a
+    version with no registered migration is taken as is. Newer minors lose the top-level
+    keys the current schema does not know.
+
+    Raises:
+        FormatVersionError: see :func:`check_compatible`; or a migration loops.
+    """
+    current = current or FORMAT_VERSION
+    migrations = MIGRATIONS if migrations is None else migrations
+    version = raw.get("format_version")
+    check_compatible(version, current=current)
+    seen: set[str] = set()
+    while _parse_version(version) < _parse_version(current) and version in migrations:
+        if version in seen:
+            raise FormatVersionError(f"manifest migrations loop at format_version {version}")
+        seen.add(version)
+        raw = migrations[version](dict(raw))
+        new = raw.get("format_version")
+        check_compatible(new, current=current)
+        log.info("migrated dataset.json from format %s to %s", version, new)
+        version = new
+    if _parse_version(version) > _parse_version(current):
+        known = set(manifest_json_schema()["properties"])
+        dropped = sorted(set(raw) - known)
+        if dropped:
+            log.warning(
+                "dataset.json format %s: ignoring keys this sgdata does not know: %s",
+                version,
+                dropped,
+            )
+        raw = {k: v for k, v in raw.items() if k in known}
+    return raw
+
+
+# --------------------------------------------------------------------------- docs
+
+
 def _type_text(t: pa.DataType) -> str:
     if pa.types.is_fixed_size_list(t):
         return f"{_type_text(t.value_type)}[{t.list_size}]"
@@ -169,13 +273,14 @@ def _type_text(t: pa.DataType) -> str:
         return f"list<{_type_text(t.value_type)}>"
     if pa.types.is_struct(t):
         return "struct"
-    return str(t)
+    return next(name for name, p in _PRIMITIVES.items() if p == t)  # the DSL's own names
 
 
 def _rows(fields: list[pa.Field], prefix: str) -> list[str]:
     lines = []
     for f in fields:
         doc = (f.metadata or {}).get(b"doc", b"").decode()
+        doc = doc.replace("|", "\\|").replace("<", "\\<")  # Markdown table cell
         null = "yes" if f.nullable else "no"
         lines.append(f"| `{prefix}{f.name}` | `{_type_text(f.type)}` | {null} | {doc} |")
         inner = f.type

@@ -22,8 +22,6 @@ of their float32 value: sizes and colours with at most 6 significant digits roun
 from __future__ import annotations
 
 import math
-import os
-import tempfile
 from collections.abc import Callable
 from functools import cache
 from pathlib import Path
@@ -33,6 +31,7 @@ import numpy as np
 from pxr import Gf, Kind, Sdf, Tf, Usd, UsdGeom, UsdValidation, Vt
 
 from .errors import SceneError, UsdError
+from .fileio import atomic_write_text
 from .scene import WALLS, Dynamics, Opening, Placement, Room, SceneObject
 
 if TYPE_CHECKING:
@@ -231,15 +230,7 @@ def write_text_atomic(path: Path, text: str) -> None:
     """
     path = Path(path)
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-        try:
-            with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as out:
-                out.write(text)
-            os.replace(tmp, path)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
+        atomic_write_text(path, text)
     except OSError as exc:
         raise UsdError(f"{path}: cannot write USD file ({exc.strerror or exc})") from None
     layer = Sdf.Layer.Find(str(path))

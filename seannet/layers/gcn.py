@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 
 import torch
@@ -89,7 +90,7 @@ class GCNPathway(nn.Module):
         if not 0.0 <= dropout < 1.0:
             raise ModelError(f"dropout={dropout}; expected 0 <= dropout < 1")
         self.dims = dims
-        self.layers = nn.ModuleList(GCNLayer(a, b) for a, b in zip(dims[:-1], dims[1:]))
+        self.layers = nn.ModuleList(GCNLayer(a, b) for a, b in itertools.pairwise(dims))
         self.dropout = nn.Dropout(dropout)
 
     def reset_parameters(self) -> None:

@@ -5,7 +5,16 @@ Writer side (used by ``sgdata generate``): :func:`observation_table`, :func:`tri
 :class:`Dataset`. The format itself is described in docs/dataset.md.
 """
 
-from ..schema import FORMAT_VERSION, manifest_json_schema, observations_schema, triplets_schema
+from ..schema import (
+    FORMAT_VERSION,
+    MIGRATIONS,
+    FormatVersionError,
+    check_compatible,
+    manifest_json_schema,
+    migrate_manifest_dict,
+    observations_schema,
+    triplets_schema,
+)
 from .layout import (
     MANIFEST,
     OBSERVATIONS,
@@ -22,18 +31,14 @@ from .layout import (
     triplets_path,
 )
 from .manifest import (
-    MIGRATIONS,
     ClassEntry,
     Counts,
     FileEntry,
-    FormatVersionError,
     Generator,
     ImageInfo,
     Manifest,
-    check_compatible,
     classes_from_slots,
     file_entry,
-    migrate_manifest_dict,
     read_manifest,
     relation_type_names,
     write_manifest,

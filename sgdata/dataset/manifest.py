@@ -1,22 +1,17 @@
-"""``dataset.json``: the manifest as a typed, validated dataclass, and the one version check.
+"""``dataset.json``: the manifest as a typed, validated dataclass.
 
 The manifest is validated twice over, and every problem is reported at once: first against
 ``schemas/manifest.v1.schema.json`` (JSON Schema 2020-12, shapes and types), then by
 :meth:`Manifest.problems` (cross-field rules: class ids, slot runs, counts vs splits, files).
 
-Versioning (see docs/dataset.md): :data:`~sgdata.schema.FORMAT_VERSION` is semver. A dataset of
-the same major version is read; one of an older minor first passes through the migrations in
-:data:`MIGRATIONS` (keyed by the version they migrate *from*), one of a newer minor has its
-unknown top-level keys dropped (minor versions only add). Any other major is refused by
-:func:`check_compatible` with the command that fixes it.
+Before either, the raw dict goes through :func:`sgdata.schema.migrate_manifest_dict`: the one
+version check (:func:`sgdata.schema.check_compatible`) and the migrations of older minors.
 """
 
 from __future__ import annotations
 
 import json
-import logging
-import re
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -26,22 +21,18 @@ import jsonschema
 from ..errors import DatasetError
 from ..fileio import atomic_write_text
 from ..relations import RelationType
-from ..schema import FORMAT_VERSION, manifest_json_schema
+from ..schema import FORMAT_VERSION, manifest_json_schema, migrate_manifest_dict
 from .layout import MANIFEST, SPLITS
 from .rows import sha256_file
 
 __all__ = [
     "FORMAT_NAME",
-    "MIGRATIONS",
     "ClassEntry",
     "FileEntry",
-    "FormatVersionError",
     "Generator",
     "ImageInfo",
     "Counts",
     "Manifest",
-    "check_compatible",
-    "migrate_manifest_dict",
     "classes_from_slots",
     "file_entry",
     "relation_type_names",
@@ -51,89 +42,6 @@ __all__ = [
 
 FORMAT_NAME = "sgdata"
 NUM_TIERS = 5
-UPGRADE_HINT = "upgrade sgdata: pip install -U sgdata"
-# from-version -> function taking the raw manifest dict of that version and returning the dict
-# of the next version (with its format_version set). Empty: 1.0.0 is the first format.
-MIGRATIONS: dict[str, Callable[[dict[str, Any]], dict[str, Any]]] = {}
-
-_SEMVER = re.compile(r"^(0|[1-9]\d*)\.(0|[1-9]\d*)\.(0|[1-9]\d*)(?:[-+][0-9A-Za-z.+-]+)?$")
-log = logging.getLogger(__name__)
-
-
-class FormatVersionError(DatasetError):
-    """The dataset's ``format_version`` is malformed or not readable by this sgdata."""
-
-
-def _parse_version(version: object) -> tuple[int, int, int]:
-    match = _SEMVER.match(version) if isinstance(version, str) else None
-    if match is None:
-        raise FormatVersionError(
-            f"dataset.json format_version {version!r}: expected a semantic version like "
-            f"{FORMAT_VERSION}; the manifest is corrupt (regenerate the dataset)"
-        )
-    return int(match[1]), int(match[2]), int(match[3])
-
-
-def check_compatible(manifest_version: str, *, current: str = FORMAT_VERSION) -> None:
-    """Whether this sgdata reads a dataset of format ``manifest_version``; raises if not.
-
-    Raises:
-        FormatVersionError: malformed version, or another major version than ``current``.
-    """
-    major = _parse_version(manifest_version)[0]
-    ours = _parse_version(current)[0]
-    if major > ours:
-        raise FormatVersionError(
-            f"dataset.json format_version {manifest_version} is newer than this sgdata reads "
-            f"({ours}.x); {UPGRADE_HINT}"
-        )
-    if major < ours:
-        raise FormatVersionError(
-            f"dataset.json format_version {manifest_version} is older than this sgdata reads "
-            f"({ours}.x); read it with an older sgdata (pip install 'sgdata<{ours}') or "
-            "regenerate it: sgdata generate"
-        )
-
-
-def migrate_manifest_dict(
-    raw: dict[str, Any],
-    *,
-    current: str = FORMAT_VERSION,
-    migrations: Mapping[str, Callable[[dict[str, Any]], dict[str, Any]]] | None = None,
-) -> dict[str, Any]:
-    """``raw`` (a parsed ``dataset.json``) brought to version ``current``'s shape.
-
-    Older minors go through ``migrations`` (default :data:`MIGRATIONS`) step by step; a
-    version with no registered migration is taken as is. Newer minors lose the top-level
-    keys the current schema does not know.
-
-    Raises:
-        FormatVersionError: see :func:`check_compatible`; or a migration loops.
-    """
-    migrations = MIGRATIONS if migrations is None else migrations
-    version = raw.get("format_version")
-    check_compatible(version, current=current)
-    seen: set[str] = set()
-    while _parse_version(version) < _parse_version(current) and version in migrations:
-        if version in seen:
-            raise FormatVersionError(f"manifest migrations loop at format_version {version}")
-        seen.add(version)
-        raw = migrations[version](dict(raw))
-        new = raw.get("format_version")
-        check_compatible(new, current=current)
-        log.info("migrated dataset.json from format %s to %s", version, new)
-        version = new
-    if _parse_version(version) > _parse_version(current):
-        known = set(manifest_json_schema()["properties"])
-        dropped = sorted(set(raw) - known)
-        if dropped:
-            log.warning(
-                "dataset.json format %s: ignoring keys this sgdata does not know: %s",
-                version,
-                dropped,
-            )
-        raw = {k: v for k, v in raw.items() if k in known}
-    return raw
 
 
 @dataclass(frozen=True)
@@ -316,7 +224,7 @@ class Manifest:
         validator = jsonschema.Draft202012Validator(manifest_json_schema())
         errors = sorted(validator.iter_errors(raw), key=lambda e: list(map(str, e.path)))
         if errors:
-            lines = [f"{_where(e)}: {e.message}" for e in errors]
+            lines = [_describe(e) for e in errors]
             raise DatasetError(_report(f"{source} does not match the manifest schema", lines))
         counts = raw["counts"]
         try:
@@ -378,8 +286,10 @@ def _report(title: str, lines: list[str]) -> str:
     return f"{title} ({len(lines)} problem{'s' if len(lines) != 1 else ''}): " + "; ".join(lines)
 
 
-def _where(error: jsonschema.ValidationError) -> str:
-    return "/".join(str(p) for p in error.absolute_path) or "(top level)"
+def _describe(error: jsonschema.ValidationError) -> str:
+    where = "/".join(str(p) for p in error.absolute_path) or "(top level)"
+    got = f" (got {error.instance!r})" if error.validator == "const" else ""
+    return f"{where}: {error.message}{got}"
 
 
 def _sorted_keys(value: Any) -> Any:

@@ -120,20 +120,33 @@ class Dataset:
         return [self._root / observations_path(split, room) for room in self._split(split)]
 
     def _read(self, path: Path, columns: Sequence[str] | None, schema: pa.Schema) -> pa.Table:
+        """Read ``columns`` (default: every column of ``schema``) of one file and check them.
+
+        Columns the file has beyond the schema (a newer minor format) are not read.
+        """
         if not path.is_file():
             raise DatasetError(
                 f"{path}: listed by {MANIFEST} but missing; the dataset is incomplete "
                 "(copy it again, or run sgdata generate --resume)"
             )
+        names = list(schema.names if columns is None else columns)
         try:
-            table = pq.read_table(path, columns=list(columns) if columns is not None else None)
+            found = pq.read_schema(path)
+            missing = [n for n in names if n not in found.names]
+            if missing:
+                raise DatasetError(
+                    f"{path}: no column(s) {missing}; not a format "
+                    f"{self._manifest.format_version} {schema.metadata[b'name'].decode()} table"
+                )
+            table = pq.read_table(path, columns=names)
         except (pa.ArrowException, OSError) as exc:
             raise DatasetError(f"{path}: not a readable Parquet file ({exc})") from None
-        expected = schema if columns is None else pa.schema([schema.field(c) for c in columns])
+        expected = pa.schema([schema.field(n) for n in names])
         if not table.schema.equals(expected):
+            wrong = [f.name for f in table.schema if not f.equals(expected.field(f.name))]
             raise DatasetError(
-                f"{path}: columns do not match the format {self._manifest.format_version} "
-                f"schema; expected {expected.names}, found {table.schema.names}"
+                f"{path}: column(s) {wrong} differ from the format "
+                f"{self._manifest.format_version} schema (see docs/dataset.md)"
             )
         return table
 

@@ -171,6 +171,7 @@ def observation_table(
     split: str,
     class_ids: dict[str, int],
     scene_path: str | None = SCENE_LAYER,
+    scene_paths: Sequence[str | None] | None = None,
     image_format: str = "png",
     jpeg_quality: int = 92,
 ) -> pa.Table:
@@ -183,6 +184,8 @@ def observation_table(
         class_ids: class name -> index in the manifest's class vocabulary.
         scene_path: template of the ``scene`` column, formatted with ``room_id`` and
             ``layout`` (default ``scenes/{room_id}/layout_{layout}.usda``); ``None`` for null.
+        scene_paths: the ``scene`` column given per record instead (overrides
+            ``scene_path``); must have one entry per record.
         image_format: ``png`` (lossless, default) or ``jpeg``.
         jpeg_quality: JPEG quality, 1..100 (ignored for PNG).
 
@@ -204,10 +207,15 @@ def observation_table(
         ],
         fields=[cam_t.field(i) for i in range(cam_t.num_fields)],
     )
-    scenes = [
-        None if scene_path is None else scene_path.format(room_id=r.room_id, layout=r.layout)
-        for r in records
-    ]
+    if scene_paths is not None:
+        if len(scene_paths) != n:
+            raise DatasetError(f"{len(scene_paths)} scene_paths for {n} records; expected one each")
+        scenes = list(scene_paths)
+    else:
+        scenes = [
+            None if scene_path is None else scene_path.format(room_id=r.room_id, layout=r.layout)
+            for r in records
+        ]
     columns = {
         "obs_id": pa.array(ids, type=pa.string()),
         "room_id": pa.array([r.room_id for r in records], type=pa.string()),

@@ -1,0 +1,219 @@
+"""SeanNet, the scene-embedding network (paper §IV), and the ``build_model`` factory."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+import torch
+from torch import Tensor, nn
+from torchvision.ops import roi_align
+
+from .backbones import ENCODER_NAMES, resnet_c4
+from .baselines import ImageEncoder
+from .batch import NUM_RELATIONS, SceneBatch
+from .errors import ModelError
+from .layers import MultiPathwayGCN, ObjectEmbedding
+from .wordvectors import WordVectorTable
+
+__all__ = ["SeanNet", "MODEL_NAMES", "build_model"]
+
+MODEL_NAMES = ("seannet", *ENCODER_NAMES)
+
+
+class SeanNet(nn.Module):
+    r"""SeanNet: an image and its scene graph → one scene embedding.
+
+    From "SeanNet: Semantic Understanding Network for Localization Under Object Dynamics"
+    (https://arxiv.org/abs/2110.02276), §IV, with the input contract of DESIGN §8:
+
+    1. **Image branch.** A ResNet split at C4: backbone :math:`I \mapsto C_4` (1024 × 14 × 14
+       for ResNet-50 at 224²), head (5th stage + pool) :math:`C_4 \mapsto v_I` (2048).
+    2. **Object embeddings.** Each box is RoI-aligned on *its own view's* :math:`C_4`
+       (``box_view`` is the RoI batch index; the authors' code pooled every box from the
+       first image) to ``roi_size`` × ``roi_size``, and passed through the *same* head
+       (shared weights) → :math:`x_v`; with :math:`x_b` (box PE) and :math:`x_w` (word
+       vector): :math:`x_i = \mathrm{fcn}([x_v; x_b; x_w])` (512).
+    3. **Scene-graph branch.** :math:`x_i` are scattered into :math:`X^{(0)}` (B × M × 512)
+       at (view, slot), zero rows for empty slots, and a :class:`MultiPathwayGCN` on the
+       on / in / proximity adjacencies gives :math:`g` (2048).
+    4. **Fusion.** :math:`f = W_f [v_I; g] + b_f` (2048). The paper's Fig. 2 merges the two
+       2048-d vectors into one 2048-d vector without saying how; we concatenate and apply
+       one linear layer. A learned linear map lets training weigh the branches (a plain sum
+       would tie their scales), and having no activation after it lets the embedding take
+       either sign, so cosine similarity uses the whole sphere rather than one orthant.
+
+    Dropout (0.2) is used in the GCN only, as in the paper (§V-B).
+
+    Args:
+        word_vectors: :math:`(C, D_w)` class word vectors, row c for class id c (catalog
+            order); fixed, not trained.
+        depth: ResNet depth, 18, 34 or 50 (default 50). C4/head widths: 256/512 for 18/34,
+            1024/2048 for 50.
+        num_slots: M, GCN node slots (default 256).
+        roi_size: RoIAlign output size (default 14, as the paper; 7 halves a CPU preset's cost).
+        box_dim_per_coord: PE channels per box corner coordinate (default 64).
+        object_dims: object fcn widths (default (1024, 512)).
+        gcn_dims: pathway widths after the object width (default (256, 64, 8)).
+        graph_hidden_dim: hidden width of the GCN's fcn (default 4096).
+        embed_dim: width of the graph and scene embeddings (default 2048).
+        dropout: GCN dropout (default 0.2).
+        pretrained: a local torchvision ResNet state_dict for the backbone and head.
+        pretrained_sha256: its expected SHA-256 (default: torchvision's known weights).
+
+    Shapes:
+        - **batch**: a :class:`~seannet.batch.SceneBatch` with B views, K boxes, M slots
+        - **output**: :math:`(B, \text{embed\_dim})`
+    """
+
+    def __init__(
+        self,
+        word_vectors: Tensor | np.ndarray,
+        *,
+        depth: int = 50,
+        num_slots: int = 256,
+        roi_size: int = 14,
+        box_dim_per_coord: int = 64,
+        object_dims: Sequence[int] = (1024, 512),
+        gcn_dims: Sequence[int] = (256, 64, 8),
+        graph_hidden_dim: int = 4096,
+        embed_dim: int = 2048,
+        dropout: float = 0.2,
+        pretrained: Path | None = None,
+        pretrained_sha256: str | None = None,
+    ) -> None:
+        super().__init__()
+        if roi_size <= 0:
+            raise ModelError(f"roi_size={roi_size}; expected a positive integer")
+        if embed_dim <= 0:
+            raise ModelError(f"embed_dim={embed_dim}; expected a positive integer")
+        split = resnet_c4(depth, pretrained=pretrained, sha256=pretrained_sha256)
+        self.depth = depth
+        self.num_slots = num_slots
+        self.roi_size = roi_size
+        self.embed_dim = embed_dim
+        self.c4_stride = split.stride
+        self.backbone = split.backbone
+        self.head = split.head  # shared by the image branch and every object
+        self.objects = ObjectEmbedding(
+            torch.as_tensor(word_vectors, dtype=torch.float32),
+            split.head_dim,
+            box_dim_per_coord=box_dim_per_coord,
+            hidden_dims=object_dims,
+        )
+        self.gcn = MultiPathwayGCN(
+            num_slots,
+            (self.objects.out_dim, *gcn_dims),
+            num_relations=NUM_RELATIONS,
+            hidden_dim=graph_hidden_dim,
+            out_dim=embed_dim,
+            dropout=dropout,
+        )
+        self.fusion = nn.Linear(split.head_dim + embed_dim, embed_dim)
+
+    @property
+    def num_classes(self) -> int:
+        return self.objects.num_classes
+
+    def object_features(self, c4: Tensor, batch: SceneBatch) -> Tensor:
+        """:math:`x_i` of every box, RoI-aligned on its own view's C4 map. (K, 512)."""
+        rois = torch.cat((batch.box_view.to(c4.dtype).unsqueeze(1), batch.boxes.to(c4.dtype)), 1)
+        # aligned=True: box coordinates are continuous pixel edges (u2 exclusive = right edge
+        # of the last pixel), so the half-pixel shift maps them onto C4 sample centres exactly
+        crops = roi_align(
+            c4,
+            rois,
+            output_size=self.roi_size,
+            spatial_scale=1.0 / self.c4_stride,
+            sampling_ratio=-1,
+            aligned=True,
+        )
+        return self.objects(self.head(crops), batch.boxes, batch.class_ids)
+
+    def node_features(self, x: Tensor, batch: SceneBatch) -> Tensor:
+        """Scatter object embeddings to :math:`X^{(0)}` (B, M, F) at (view, slot)."""
+        x0 = x.new_zeros(batch.num_views, self.num_slots, x.shape[1])
+        return x0.index_put((batch.box_view, batch.slots), x)
+
+    def embed(self, batch: SceneBatch) -> Tensor:
+        """Scene embeddings (B, embed_dim) of a batch.
+
+        Raises:
+            DataError: the batch's indices are out of range or two boxes share a node.
+            ModelError: the batch's M differs from the model's.
+        """
+        if batch.num_slots != self.num_slots:
+            raise ModelError(
+                f"batch has M = {batch.num_slots} slots, the model {self.num_slots}; build the "
+                f"model with num_slots={batch.num_slots} or fix the dataset's slot table"
+            )
+        batch.validate(num_classes=self.num_classes)
+        c4 = self.backbone(batch.images)
+        image = self.head(c4)
+        if batch.boxes.shape[0]:
+            x = self.object_features(c4, batch)
+        else:
+            x = c4.new_zeros(0, self.objects.out_dim)
+        graph = self.gcn(self.node_features(x, batch), batch.adjacency.to(c4.dtype))
+        return self.fusion(torch.cat((image, graph), dim=1))
+
+    def forward(self, batch: SceneBatch) -> Tensor:
+        return self.embed(batch)
+
+
+def build_model(
+    name: str,
+    *,
+    depth: int = 50,
+    num_slots: int = 256,
+    word_vectors: WordVectorTable | None = None,
+    class_names: Sequence[str] | None = None,
+    roi_size: int = 14,
+    embed_dim: int = 2048,
+    dropout: float = 0.2,
+    pretrained: Path | None = None,
+    pretrained_sha256: str | None = None,
+) -> SeanNet | ImageEncoder:
+    """SeanNet or an image baseline by name; every model has ``embed(batch) -> (B, D)``.
+
+    Args:
+        name: ``"seannet"`` or a baseline of :data:`seannet.backbones.ENCODER_NAMES`.
+        depth: SeanNet's ResNet depth (18, 34, 50); ignored by baselines.
+        num_slots: SeanNet's M.
+        word_vectors: the class word-vector table (default: the shipped one).
+        class_names: class-id order (default: the catalog's ``names()``).
+        roi_size: SeanNet's RoIAlign output size.
+        embed_dim: embedding width.
+        dropout: SeanNet's GCN dropout.
+        pretrained: a local torchvision state_dict file (default: random init, no download).
+        pretrained_sha256: its expected SHA-256 (default: torchvision's known weights).
+
+    Raises:
+        ModelError: an unknown name or a bad hyper-parameter or weights file.
+        DataError: the word-vector table lacks a class.
+    """
+    if name in ENCODER_NAMES:
+        return ImageEncoder(
+            name, embed_dim=embed_dim, pretrained=pretrained, pretrained_sha256=pretrained_sha256
+        )
+    if name != "seannet":
+        raise ModelError(f"model {name!r}; expected one of {', '.join(MODEL_NAMES)}")
+    if word_vectors is None:
+        from .wordvectors import load_table
+
+        word_vectors = load_table()
+    if class_names is None:
+        from sgdata.catalog import load_catalog
+
+        class_names = load_catalog().names()
+    return SeanNet(
+        word_vectors.matrix(class_names),
+        depth=depth,
+        num_slots=num_slots,
+        roi_size=roi_size,
+        embed_dim=embed_dim,
+        dropout=dropout,
+        pretrained=pretrained,
+        pretrained_sha256=pretrained_sha256,
+    )

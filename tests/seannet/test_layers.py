@@ -1,0 +1,143 @@
+"""SeanNet's layers: box positional encoding, GCN layer / pathway / multi-pathway, object fcn."""
+
+from __future__ import annotations
+
+import pytest
+import torch
+from torch.nn import functional as F
+
+from seannet import ModelError
+from seannet.layers import (
+    BoxEncoding,
+    GCNLayer,
+    GCNPathway,
+    MultiPathwayGCN,
+    ObjectEmbedding,
+    sinusoidal_encoding,
+)
+
+
+def test_sinusoidal_encoding_matches_the_transformer_formula() -> None:
+    pos = torch.tensor([0.0, 3.0, 117.5])
+    code = sinusoidal_encoding(pos, 64)
+    assert code.shape == (3, 64)
+    i = torch.arange(32, dtype=torch.float32)
+    angle = pos[:, None] / 10000 ** (2 * i / 64)
+    torch.testing.assert_close(code[:, 0::2], angle.sin())
+    torch.testing.assert_close(code[:, 1::2], angle.cos())
+    assert torch.equal(code[0, 0::2], torch.zeros(32)) and torch.equal(
+        code[0, 1::2], torch.ones(32)
+    )
+
+
+def test_box_encoding_dims_and_corner_order() -> None:
+    enc = BoxEncoding()
+    boxes = torch.tensor([[10.0, 20.0, 30.0, 40.0], [0.0, 0.0, 224.0, 224.0]])
+    code = enc(boxes)
+    assert enc.out_dim == 256 and code.shape == (2, 256)
+    for j in range(4):  # x_b = [PE(u1); PE(v1); PE(u2); PE(v2)]
+        torch.testing.assert_close(
+            code[:, 64 * j : 64 * (j + 1)], sinusoidal_encoding(boxes[:, j], 64)
+        )
+    assert not any(True for _ in enc.parameters())
+
+
+def test_similar_boxes_get_similar_codes() -> None:
+    enc = BoxEncoding()
+    base = torch.tensor([[40.0, 60.0, 120.0, 150.0]])
+    shifts = torch.tensor([0.0, 1.0, 4.0, 30.0, 100.0])
+    boxes = base + shifts[:, None]
+    sim = F.cosine_similarity(enc(base), enc(boxes), dim=1)
+    assert sim[0] == pytest.approx(1.0)
+    assert sim[1] > 0.8
+    assert torch.all(sim[:3] > sim[1:4])  # less similar as the corners move away ...
+    assert sim[-1] < sim[2]  # ... and far boxes (100 px) stay far below near ones (4 px)
+
+
+@pytest.mark.parametrize("dim", [0, 7, -2])
+def test_encoding_rejects_odd_or_empty_dims(dim: int) -> None:
+    with pytest.raises(ModelError, match=f"dim_per_coord={dim}"):
+        BoxEncoding(dim)
+
+
+def _row_normalised(a: torch.Tensor) -> torch.Tensor:
+    rows = a.sum(-1, keepdim=True)
+    return torch.where(rows > 0, a / rows.clamp(min=1e-12), torch.zeros_like(a))
+
+
+def test_gcn_layer_is_a_hat_x_w() -> None:
+    torch.manual_seed(0)
+    layer = GCNLayer(5, 3)
+    x = torch.randn(2, 4, 5)
+    a = _row_normalised(torch.rand(2, 4, 4))
+    ref = torch.stack([a[i] @ x[i] @ layer.weight for i in range(2)])
+    torch.testing.assert_close(layer(x, a), ref)
+    assert layer.bias is None
+
+
+def test_gcn_keeps_absent_nodes_zero_and_adjacency_unchanged() -> None:
+    torch.manual_seed(0)
+    m, present = 10, torch.tensor([1, 4, 7])
+    x = torch.zeros(1, m, 16)
+    x[0, present] = torch.randn(3, 16)
+    a = torch.zeros(1, m, m)
+    a[0][present.unsqueeze(1), present.unsqueeze(0)] = torch.rand(3, 3) + 0.1
+    a = _row_normalised(a)
+    a_before = a.clone()
+    pathway = GCNPathway((16, 8, 4, 2), dropout=0.2).eval()
+    out = pathway(x, a)
+    assert out.shape == (1, m, 2)
+    absent = torch.ones(m, dtype=torch.bool)
+    absent[present] = False
+    assert not out[0, absent].any()
+    assert torch.equal(a, a_before)  # the GCN reads Â, never renormalises it in place
+    torch.testing.assert_close(a.sum(-1)[0, present], torch.ones(3))
+
+
+def test_row_normalised_adjacency_averages_neighbours() -> None:
+    layer = GCNLayer(3, 3)
+    with torch.no_grad():
+        layer.weight.copy_(torch.eye(3))
+    x = torch.tensor([[[1.0, 0, 0], [0, 2.0, 0], [0, 0, 3.0]]])
+    a = _row_normalised(torch.ones(1, 3, 3))
+    torch.testing.assert_close(
+        layer(x, a), torch.full((1, 3, 3), 1 / 3) * torch.tensor([1, 2, 3.0])
+    )
+
+
+def test_multi_pathway_gcn_shapes_and_paper_widths() -> None:
+    gcn = MultiPathwayGCN(num_slots=12, dims=(32, 16, 8, 4), hidden_dim=20, out_dim=10).eval()
+    x = torch.randn(2, 12, 32)
+    a = _row_normalised(torch.rand(2, 3, 12, 12))
+    assert gcn(x, a).shape == (2, 10)
+    assert gcn.fc[0].in_features == 3 * 12 * 4
+    paper = MultiPathwayGCN(hidden_dim=8)  # M = 256, 512 -> 256 -> 64 -> 8: 3 x 2048 = 6144
+    assert paper.fc[0].in_features == 6144 and paper.out_dim == 2048
+    assert [layer.out_dim for layer in paper.pathways[0].layers] == [256, 64, 8]
+    with pytest.raises(ModelError, match="expected"):
+        gcn(x, a[:, :2])
+
+
+def test_gcn_dropout_only_in_training() -> None:
+    torch.manual_seed(0)
+    pathway = GCNPathway((8, 8), dropout=0.5)
+    x = torch.rand(1, 6, 8) + 1
+    a = _row_normalised(torch.ones(1, 6, 6))
+    pathway.eval()
+    assert torch.equal(pathway(x, a), pathway(x, a))
+    pathway.train()
+    assert not torch.equal(pathway(x, a), pathway(x, a))
+    with pytest.raises(ModelError, match="dropout=1.0"):
+        GCNPathway(dropout=1.0)
+
+
+def test_object_embedding_widths_and_fixed_word_vectors() -> None:
+    words = torch.randn(4, 300)
+    emb = ObjectEmbedding(words, 2048)
+    assert emb.in_dim == 2604 and emb.out_dim == 512
+    out = emb(torch.randn(3, 2048), torch.tensor([[0.0, 0, 5, 5]] * 3), torch.tensor([0, 3, 3]))
+    assert out.shape == (3, 512) and (out >= 0).all()  # ReLU after the last layer too
+    assert "word_vectors" in dict(emb.named_buffers())
+    assert "word_vectors" not in dict(emb.named_parameters())
+    with pytest.raises(ModelError, match="word_vectors: shape"):
+        ObjectEmbedding(torch.randn(300), 2048)
