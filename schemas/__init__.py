@@ -1,1 +1,1 @@
-"""Data package: the on-disk contract — Arrow table schemas and the manifest JSON Schema (no code)."""
+"""Data package: the on-disk contract, Arrow table schemas and the manifest JSON Schema."""
