@@ -162,7 +162,9 @@ def generate(
 def render(
     room_dir: Annotated[Path, typer.Argument(help="A room directory with its layouts.")],
     layout: Annotated[int, typer.Option(help="Layout index.")] = 0,
-    pose: Annotated[str, typer.Option(help="Grid cell and heading index: I,J,H (H in 0..3).")] = "",
+    pose: Annotated[
+        str, typer.Option(help="Grid cell and heading: I,J,H (H in 0..3); default: a middle cell.")
+    ] = "",
     output: Annotated[Path, typer.Option("-o", "--output", help="PNG of the view.")] = Path(
         "view.png"
     ),
@@ -175,11 +177,14 @@ def render(
     from sgdata.preview import save_png
     from sgdata.snapshot import render_snapshot
 
-    try:
-        i, j, h = (int(v) for v in pose.split(","))
-    except ValueError:
-        raise ConfigError(f"--pose {pose!r}: expected I,J,H such as 4,6,1") from None
-    record = render_snapshot(room_dir, layout=layout, cell=(i, j), heading=h)
+    cell, heading = None, 0
+    if pose:
+        try:
+            i, j, heading = (int(v) for v in pose.split(","))
+        except ValueError:
+            raise ConfigError(f"--pose {pose!r}: expected I,J,H such as 4,6,1") from None
+        cell = (i, j)
+    record = render_snapshot(room_dir, layout=layout, cell=cell, heading=heading)
     overlay_path = output.with_suffix(".overlay.png")
     save_png(Image.fromarray(record.rgb), output)
     save_png(draw_overlay(record), overlay_path)

@@ -1,15 +1,12 @@
 #!/usr/bin/env bash
-# The main job on the small embedded default: one room of each type as USD, five layouts of
-# each as USD layers, and top-down previews.
+# The main job on the small embedded default: the `tiny` preset (kitchens and bathrooms, one
+# room per split each) generated into out/demo, then a look at one room and one view.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=${1:-out/demo}
 sgdata=.venv/bin/sgdata
-for type in kitchen living_room bedroom bathroom; do
-  room="$out/scenes/${type}_000"
-  $sgdata rooms "$out/scenes" --type "$type" --count 1 --seed 0
-  $sgdata layouts "$room" --count 5 --seed 0
-  $sgdata preview "$room/room.usda" -o "$out/previews/${type}_000.png"
-  $sgdata preview "$room/layout_1.usda" --compare -o "$out/previews/${type}_000_layout_1.png"
-done
-echo "demo: USD rooms and layouts in $out/scenes, top-down previews in $out/previews"
+$sgdata generate tiny "$out" --force
+room="$out/scenes/kitchen_000"
+$sgdata preview "$room/layout_1.usda" --compare -o "$out/previews/kitchen_000_layout_1.png"
+$sgdata render "$room" --layout 1 -o "$out/previews/kitchen_000_view.png"
+echo "demo: dataset in $out (dataset.json, observations/, triplets/, scenes/), pictures in $out/previews"

@@ -21,7 +21,7 @@ def render_snapshot(
     room_dir: Path,
     *,
     layout: int,
-    cell: tuple[int, int],
+    cell: tuple[int, int] | None,
     heading: int,
     camera: CameraConfig | None = None,
     grid_cell: float = 0.25,
@@ -30,6 +30,8 @@ def render_snapshot(
     catalog: Catalog | None = None,
 ) -> ViewRecord:
     """Render and annotate the view at grid ``cell`` and ``heading`` (0..3) of a layout.
+
+    ``cell=None`` takes the middle one of the layout's reachable cells (in index order).
 
     Raises:
         ConfigError: unknown room directory or layout, heading out of range, or a cell off the
@@ -40,6 +42,10 @@ def render_snapshot(
         raise ConfigError(f"heading {heading}: expected 0..3 (0/90/180/270 degrees)")
     room = load_layout(room_dir, layout, catalog)
     grid = pose_grid(room, cell=grid_cell, radius=robot_radius)
+    if cell is None:
+        if not grid.cells:
+            raise ConfigError(f"{room_dir}: layout {layout} has no reachable cell to render from")
+        cell = grid.cells[len(grid.cells) // 2]
     i, j = cell
     nx, ny = grid.shape
     if not (0 <= i < nx and 0 <= j < ny):

@@ -1,0 +1,114 @@
+"""End-to-end `sgdata generate` throughput and memory.
+
+    .venv/bin/python bench/generate.py                 # 1 vs 2 workers, 2 / 4 / 8 rooms
+    .venv/bin/python bench/generate.py --rooms 2 4 8 16
+
+For each room count it runs a fresh process that generates a dataset of that many rooms
+(kitchens and bathrooms, 3 layouts, 24 triplets per room, 224 x 224) and prints views/s of
+the whole run and of the render phase, and the peak resident memory of the main process and
+of the largest worker. Peak worker memory must stay flat as rooms grow: each worker renders
+one room at a time and writes its shard before taking the next.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+CONFIG = """
+[dataset]
+name = "bench"
+seed = 1
+[rooms]
+types = ["kitchen", "bathroom"]
+train = {per_type}
+val = 0
+test = 0
+[layouts]
+count = 3
+[triplets]
+train = {triplets}
+val = 0
+test = 0
+"""
+
+
+def run_one(rooms: int, workers: int) -> dict:
+    """Generate in this process; report counts, times and peak memory (MiB)."""
+    from sgdata.config import load_config
+    from sgdata.generate import generate_dataset
+
+    with tempfile.TemporaryDirectory() as tmp:
+        config_path = Path(tmp) / "bench.toml"
+        config_path.write_text(CONFIG.format(per_type=rooms // 2, triplets=24 * rooms))
+        phases: dict[str, float] = {}
+
+        def progress(step) -> None:  # noqa: ANN001
+            phases[step.phase] = step.elapsed
+            phases[f"{step.phase}_views"] = step.views
+
+        start = time.perf_counter()
+        manifest = generate_dataset(
+            load_config(config_path), Path(tmp) / "data", workers=workers, progress=progress
+        )
+        wall = time.perf_counter() - start
+    views = sum(manifest["counts"]["observations"].values())
+    return {
+        "rooms": rooms,
+        "workers": workers,
+        "views": views,
+        "wall_s": round(wall, 2),
+        "views_per_s": round(views / wall, 2),
+        "render_views_per_s": round(views / phases["views"], 2),
+        "main_peak_mib": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1),
+        "worker_peak_mib": round(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024, 1),
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--rooms", type=int, nargs="+", default=[2, 4, 8])
+    parser.add_argument("--workers", type=int, nargs="+", default=[1, 2])
+    parser.add_argument("--one", nargs=2, type=int, help=argparse.SUPPRESS)  # rooms workers
+    args = parser.parse_args()
+    if args.one:
+        print(json.dumps(run_one(*args.one)))
+        return
+    rows = []
+    for rooms in args.rooms:
+        for workers in args.workers:
+            # a fresh process per measurement, so peak memory is that run's alone
+            out = subprocess.run(
+                [sys.executable, __file__, "--one", str(rooms), str(workers)],
+                capture_output=True,
+                text=True,
+                check=True,
+            )
+            rows.append(json.loads(out.stdout.strip().splitlines()[-1]))
+            print(rows[-1], flush=True)
+    print()
+    print(
+        "| rooms | workers | views | wall (s) | views/s | render views/s | main peak (MiB) "
+        "| worker peak (MiB) |"
+    )
+    print("|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        print(
+            f"| {r['rooms']} | {r['workers']} | {r['views']} | {r['wall_s']} | {r['views_per_s']} "
+            f"| {r['render_views_per_s']} | {r['main_peak_mib']} | {r['worker_peak_mib']} |"
+        )
+    for rooms in args.rooms:
+        by_workers = {r["workers"]: r for r in rows if r["rooms"] == rooms}
+        if 1 in by_workers and 2 in by_workers:
+            ratio = by_workers[2]["views_per_s"] / by_workers[1]["views_per_s"]
+            print(f"{rooms} rooms: 2 workers / 1 worker = {ratio:.2f}x views/s")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,632 @@
+"""PyTorch datasets over an sgdata dataset: triplets and single views as SceneBatch tensors.
+
+The reader side of the on-disk format (docs/dataset.md) for training and evaluation:
+
+- :class:`ImageTransform` resizes a view and its boxes together and normalises the image.
+- :func:`graph_tensors` turns one row's ``objects`` and ``relations`` into slot, class, box and
+  row-normalised adjacency tensors (DESIGN §8).
+- :class:`TripletDataset` (training) and :class:`ObservationDataset` (evaluation) yield those
+  tensors per view; :func:`collate_triplets` and :func:`collate_views` batch them into
+  :class:`~seannet.batch.SceneBatch` objects for ``torch.utils.data.DataLoader``.
+- :func:`dataset_identity` names the data a model was trained on, for checkpoints.
+
+Files are opened lazily in each process that reads (``DataLoader`` workers included): a
+dataset object holds only plain Python and numpy state until its first item is read, and the
+per-process cache is keyed by ``os.getpid()`` so nothing read before a fork is reused after it.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+import torch
+from PIL import Image
+from torch import Tensor
+from torch.utils.data import Dataset as TorchDataset
+
+from sgdata.dataset import Dataset, decode_image
+from sgdata.errors import DatasetError
+
+from .batch import NUM_RELATIONS, SceneBatch
+from .errors import DataError
+
+__all__ = [
+    "IMAGENET_MEAN",
+    "IMAGENET_STD",
+    "ImageTransform",
+    "ObservationDataset",
+    "ObservationItem",
+    "TripletDataset",
+    "TripletItem",
+    "ViewTensors",
+    "collate_triplets",
+    "collate_views",
+    "dataset_identity",
+    "graph_tensors",
+    "open_dataset",
+]
+
+# torchvision's ImageNet statistics (RGB, on [0, 1] pixels): what the pretrained ResNet saw.
+IMAGENET_MEAN = (0.485, 0.456, 0.406)
+IMAGENET_STD = (0.229, 0.224, 0.225)
+
+# Observation columns a view needs: the encoded image and the scene graph.
+_VIEW_COLUMNS = ("image", "objects", "relations")
+# Observation columns kept per view for evaluation (ObservationItem).
+_META_COLUMNS = ("obs_id", "room_id", "layout", "grid_i", "grid_j", "heading")
+
+
+# ---------------------------------------------------------------------------------- opening
+
+
+def open_dataset(root: str | Path) -> Dataset:
+    """:meth:`sgdata.dataset.Dataset.open`, with its errors as one-line :class:`DataError`.
+
+    Raises:
+        DataError: ``root`` is missing, not an sgdata dataset, or of an unreadable format.
+    """
+    try:
+        return Dataset.open(root)
+    except DatasetError as exc:
+        raise DataError(_one_line(f"dataset {root}: {exc}")) from None
+
+
+def dataset_identity(root: str | Path | Dataset) -> dict[str, Any]:
+    """What a model trained on this dataset depends on; checkpoints store it to refuse others.
+
+    Returns:
+        ``{"name", "version", "format_version", "num_slots", "vocabulary_sha256"}``; the hash
+        covers the class vocabulary in id order with each class's slot run (name, id,
+        slot_start, slot_count) and the relation type names, as canonical JSON.
+
+    Raises:
+        DataError: ``root`` is not a readable dataset.
+    """
+    ds = root if isinstance(root, Dataset) else open_dataset(root)
+    m = ds.manifest
+    vocabulary = {
+        "classes": [[c.name, c.id, c.slot_start, c.slot_count] for c in m.classes],
+        "relation_types": list(m.relation_types),
+    }
+    text = json.dumps(vocabulary, separators=(",", ":"), sort_keys=True)
+    return {
+        "name": m.name,
+        "version": m.version,
+        "format_version": m.format_version,
+        "num_slots": int(m.num_slots),
+        "vocabulary_sha256": hashlib.sha256(text.encode()).hexdigest(),
+    }
+
+
+def _one_line(text: str) -> str:
+    return " ".join(text.split())
+
+
+# ---------------------------------------------------------------------------------- images
+
+
+@dataclass(frozen=True)
+class ImageTransform:
+    """Resize a view to ``size`` x ``size`` and normalise it the torchvision way.
+
+    The image is resized with Pillow's bilinear filter (antialiased when shrinking), converted
+    to float32 CHW on [0, 1], then normalised per channel as ``(x - mean) / std`` with the
+    ImageNet statistics by default (what torchvision's pretrained ResNet expects). Boxes are
+    scaled by the same factors ``size / width`` and ``size / height``, so they stay in the
+    pixel frame of the resized image (continuous edges, u2 and v2 exclusive). A view already
+    at ``size`` is not resampled.
+    """
+
+    size: int = 224  # output height and width in pixels (SeanNet: 224; a CPU preset: 112)
+    mean: tuple[float, float, float] = IMAGENET_MEAN  # per-channel mean, RGB, [0, 1] scale
+    std: tuple[float, float, float] = IMAGENET_STD  # per-channel std, RGB, [0, 1] scale
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.size, int) or self.size < 1:
+            raise DataError(f"ImageTransform size={self.size!r}; expected a positive integer")
+        if len(self.mean) != 3 or len(self.std) != 3:
+            raise DataError(f"ImageTransform mean/std {self.mean}/{self.std}; expected 3 each")
+        if min(self.std) <= 0:
+            raise DataError(f"ImageTransform std={self.std}; expected positive values")
+
+    def __call__(self, rgb: np.ndarray, boxes: np.ndarray) -> tuple[Tensor, Tensor]:
+        """Transform one view.
+
+        Args:
+            rgb: (H, W, 3) uint8 image.
+            boxes: (K, 4) pixel boxes [u1, v1, u2, v2] in the frame of ``rgb``.
+
+        Returns:
+            ``(image, boxes)``: (3, size, size) float32 and (K, 4) float32 in the new frame.
+        """
+        h, w = rgb.shape[:2]
+        s = self.size
+        if (h, w) != (s, s):
+            rgb = np.asarray(Image.fromarray(rgb).resize((s, s), Image.Resampling.BILINEAR))
+        x = rgb.astype(np.float32) * np.float32(1 / 255)
+        x -= np.asarray(self.mean, dtype=np.float32)
+        x /= np.asarray(self.std, dtype=np.float32)
+        image = torch.from_numpy(np.ascontiguousarray(x.transpose(2, 0, 1)))
+        scale = np.asarray([s / w, s / h, s / w, s / h], dtype=np.float32)
+        return image, torch.from_numpy(np.asarray(boxes, dtype=np.float32).reshape(-1, 4) * scale)
+
+
+# ---------------------------------------------------------------------------------- graphs
+
+
+def _struct_columns(rows: Any, names: Sequence[str]) -> dict[str, np.ndarray]:
+    """Columns ``names`` of a list of structs, as pyarrow gives it (or as ``to_pylist``)."""
+    if isinstance(rows, pa.ListScalar):
+        rows = rows.values if rows.is_valid else pa.array([], type=rows.type.value_type)
+    if rows is None:
+        rows = []
+    if isinstance(rows, pa.ChunkedArray):
+        rows = rows.combine_chunks()
+    if isinstance(rows, pa.StructArray):
+        children = dict(zip([f.name for f in rows.type], rows.flatten(), strict=True))
+        out = {}
+        for n in names:
+            child = children[n]
+            if pa.types.is_fixed_size_list(child.type):
+                width = child.type.list_size
+                out[n] = child.flatten().to_numpy(zero_copy_only=False).reshape(-1, width)
+            else:
+                out[n] = child.to_numpy(zero_copy_only=False)
+        return out
+    rows = list(rows)
+    return {n: np.asarray([r[n] for r in rows]) for n in names}
+
+
+def graph_tensors(
+    objects: Any, relations: Any, *, num_slots: int
+) -> tuple[Tensor, Tensor, Tensor, Tensor]:
+    """The per-view graph tensors of one observation row.
+
+    Args:
+        objects: the row's ``objects`` list of structs — a ``pyarrow.ListScalar`` (a cell of the
+            column), its ``StructArray`` of values, or the ``to_pylist()`` list of dicts.
+        relations: the row's ``relations`` list of structs, in any of the same forms.
+        num_slots: M, the GCN node slots (the manifest's ``num_slots``).
+
+    Returns:
+        ``(slots, class_ids, boxes, adjacency)``: (K,) long, (K,) long, (K, 4) float32 pixel
+        boxes in the image's own frame (objects in row order), and (3, M, M) float32.
+
+    Adjacency: channel r of ``on``, ``in``, ``proximity`` (relation type codes 0, 1, 2 of the
+    manifest's ``relation_types``; ``disjoint`` (3) is not fed) holds
+    ``A[r, slot(src), slot(dst)] = 1`` for each edge, then each row is divided by its sum, so
+    a node averages over its out-neighbours of that relation; rows without edges (absent
+    nodes included) stay zero. No self-loops are added: the authors' code row-normalised the
+    bare A, and the GCN layers keep a node's own feature through their input to the fusion,
+    not through A.
+
+    Raises:
+        DataError: a slot outside [0, M), two objects sharing a slot, or a relation naming
+            an instance that is not among the row's objects.
+    """
+    obj = _struct_columns(objects, ("instance", "class_id", "slot", "box2d"))
+    rel = _struct_columns(relations, ("src", "dst", "type"))
+    return _graph_from_columns(
+        obj["instance"],
+        obj["class_id"],
+        obj["slot"],
+        obj["box2d"],
+        rel["src"],
+        rel["dst"],
+        rel["type"],
+        num_slots,
+    )
+
+
+def _graph_from_columns(
+    instance: np.ndarray,
+    class_id: np.ndarray,
+    slot: np.ndarray,
+    box2d: np.ndarray,
+    src: np.ndarray,
+    dst: np.ndarray,
+    rtype: np.ndarray,
+    num_slots: int,
+) -> tuple[Tensor, Tensor, Tensor, Tensor]:
+    """:func:`graph_tensors` on numpy columns (the datasets' fast path)."""
+    m = num_slots
+    slot = np.asarray(slot, dtype=np.int64)
+    if slot.size and (slot.min() < 0 or slot.max() >= m):
+        bad = int(slot.min()) if slot.min() < 0 else int(slot.max())
+        raise DataError(f"object slot {bad} out of range; expected 0 <= slot < {m}")
+    if np.unique(slot).size != slot.size:
+        raise DataError("two objects of one view share a GCN slot; slots must be unique")
+    adjacency = np.zeros((NUM_RELATIONS, m, m), dtype=np.float32)
+    rtype = np.asarray(rtype, dtype=np.int64)
+    fed = rtype < NUM_RELATIONS  # 'disjoint' and any later type are not GCN pathways
+    if fed.any():
+        instance = np.asarray(instance, dtype=np.int64)
+        order = np.argsort(instance, kind="stable")
+        keys = instance[order]
+        ends = np.concatenate((np.asarray(src)[fed], np.asarray(dst)[fed])).astype(np.int64)
+        pos = np.searchsorted(keys, ends)
+        pos_ok = np.minimum(pos, max(keys.size - 1, 0))
+        found = (pos < keys.size) & (keys[pos_ok] == ends) if keys.size else pos < 0
+        if not found.all():
+            missing = int(ends[~found][0])
+            raise DataError(f"a relation names instance {missing}, not among the row's objects")
+        ends_slot = slot[order][pos]
+        n = int(fed.sum())
+        adjacency[rtype[fed], ends_slot[:n], ends_slot[n:]] = 1.0
+        rowsum = adjacency.sum(axis=2, keepdims=True)
+        np.divide(adjacency, rowsum, out=adjacency, where=rowsum > 0)
+    boxes = np.asarray(box2d, dtype=np.float32).reshape(-1, 4)
+    return (
+        torch.from_numpy(slot),
+        torch.from_numpy(np.asarray(class_id, dtype=np.int64)),
+        torch.from_numpy(boxes),
+        torch.from_numpy(adjacency),
+    )
+
+
+# ---------------------------------------------------------------------------------- items
+
+
+@dataclass
+class ViewTensors:
+    """One view ready for the model (see :class:`~seannet.batch.SceneBatch` for the meaning).
+
+    Attributes:
+        image: (3, S, S) float32, normalised.
+        boxes: (K, 4) float32 pixel boxes in the S x S frame.
+        class_ids: (K,) long.
+        slots: (K,) long.
+        adjacency: (3, M, M) float32, row-normalised on / in / proximity.
+    """
+
+    image: Tensor
+    boxes: Tensor
+    class_ids: Tensor
+    slots: Tensor
+    adjacency: Tensor
+
+
+@dataclass
+class TripletItem:
+    """One training triplet: three views of one room, its cascade tier and its ids."""
+
+    anchor: ViewTensors
+    positive: ViewTensors
+    negative: ViewTensors
+    tier: int  # cascade tier 0..4
+    triplet_id: int  # row of triplets/<split>.parquet
+    room_id: str
+    ids: tuple[str, str, str]  # obs ids of anchor, positive, negative
+
+
+@dataclass
+class ObservationItem:
+    """One view of a split with its pose metadata (nullable fields are None for real photos)."""
+
+    view: ViewTensors
+    obs_id: str
+    room_id: str
+    layout: int
+    grid_i: int | None
+    grid_j: int | None
+    heading: int | None
+
+
+# ---------------------------------------------------------------------------------- storage
+
+
+class _Shard:
+    """One observation file's view columns, held as Arrow / numpy in one process.
+
+    Images stay encoded (PNG/JPEG bytes in the Arrow column) and are decoded on access; the
+    scene graphs are flattened once into numpy columns with per-row offsets.
+    """
+
+    def __init__(self, path: Path) -> None:
+        try:
+            table = pq.read_table(path, columns=list(_VIEW_COLUMNS))
+        except (pa.ArrowException, OSError) as exc:
+            raise DataError(
+                _one_line(f"{path}: not a readable observation shard ({exc})")
+            ) from None
+        self.images = table.column("image")
+        self.obj_offsets, obj = _flatten_lists(
+            table.column("objects"), ("instance", "class_id", "slot", "box2d")
+        )
+        self.rel_offsets, rel = _flatten_lists(table.column("relations"), ("src", "dst", "type"))
+        self.instance, self.class_id, self.slot, self.box2d = (
+            obj["instance"],
+            obj["class_id"],
+            obj["slot"],
+            obj["box2d"],
+        )
+        self.src, self.dst, self.type = rel["src"], rel["dst"], rel["type"]
+
+
+def _flatten_lists(
+    column: pa.ChunkedArray, names: Sequence[str]
+) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """A list<struct> column as (offsets (N+1,), {field: values}) numpy arrays."""
+    lists = column.combine_chunks() if column.num_chunks != 1 else column.chunk(0)
+    offsets = lists.offsets.to_numpy().astype(np.int64)
+    values = _struct_columns(lists.flatten(), names)
+    return offsets - offsets[0], values
+
+
+class _ViewStore:
+    """Per-process access to the views of one split: obs index, lazy shards, transform.
+
+    Holds only plain state when pickled or forked; shards are read in the process that asks
+    for a view (``os.getpid()`` keys the cache, so a fork never reuses the parent's).
+    """
+
+    def __init__(self, ds: Dataset, split: str, transform: ImageTransform) -> None:
+        self.split = split
+        self.transform = transform
+        self.num_slots = int(ds.manifest.num_slots)
+        self.files = [str(p) for p in _call(ds.observation_files, split)]
+        table = _call(ds.observations, split, columns=list(_META_COLUMNS))
+        self.meta: dict[str, list[Any]] = {n: table.column(n).to_pylist() for n in _META_COLUMNS}
+        self.obs_ids: list[str] = self.meta["obs_id"]
+        rows = [pq.read_metadata(p).num_rows for p in self.files]
+        if sum(rows) != len(self.obs_ids):
+            raise DataError(f"split {split!r}: observation shards changed while being read")
+        self.file_starts = np.concatenate(([0], np.cumsum(rows))).astype(np.int64)
+        self.locations: list[tuple[int, int]] = [
+            (f, r) for f, n in enumerate(rows) for r in range(n)
+        ]
+        self.index = dict(zip(self.obs_ids, self.locations, strict=True))
+        if len(self.index) != len(self.obs_ids):
+            raise DataError(f"split {split!r}: an obs_id repeats across its observation shards")
+        self._pid: int | None = None
+        self._shards: dict[int, _Shard] = {}
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = dict(self.__dict__)
+        state["_pid"], state["_shards"] = None, {}
+        return state
+
+    def locate(self, obs_id: str) -> tuple[int, int]:
+        try:
+            return self.index[obs_id]
+        except KeyError:
+            raise DataError(
+                f"observation {obs_id!r} is not in split {self.split!r}'s observation shards"
+            ) from None
+
+    def shard(self, f: int) -> _Shard:
+        pid = os.getpid()
+        if self._pid != pid:  # first access in this process (a fresh DataLoader worker)
+            self._pid, self._shards = pid, {}
+        shard = self._shards.get(f)
+        if shard is None:
+            shard = self._shards[f] = _Shard(Path(self.files[f]))
+        return shard
+
+    def view(self, f: int, row: int) -> ViewTensors:
+        s = self.shard(f)
+        o0, o1 = s.obj_offsets[row], s.obj_offsets[row + 1]
+        r0, r1 = s.rel_offsets[row], s.rel_offsets[row + 1]
+        obs = self.obs_ids_of(f, row)
+        try:
+            slots, class_ids, boxes, adjacency = _graph_from_columns(
+                s.instance[o0:o1],
+                s.class_id[o0:o1],
+                s.slot[o0:o1],
+                s.box2d[o0:o1],
+                s.src[r0:r1],
+                s.dst[r0:r1],
+                s.type[r0:r1],
+                self.num_slots,
+            )
+            rgb = decode_image(s.images[row].as_py())
+        except (DataError, DatasetError) as exc:
+            raise DataError(f"observation {obs!r}: {exc}") from None
+        image, boxes = self.transform(rgb, boxes.numpy())
+        return ViewTensors(image, boxes, class_ids, slots, adjacency)
+
+    def obs_ids_of(self, f: int, row: int) -> str:
+        return self.obs_ids[int(self.file_starts[f]) + row]
+
+
+def _call(fn: Any, *args: Any, **kwargs: Any) -> Any:
+    """Call an sgdata reader method, turning its DatasetError into a one-line DataError."""
+    try:
+        return fn(*args, **kwargs)
+    except DatasetError as exc:
+        raise DataError(_one_line(str(exc))) from None
+
+
+# ---------------------------------------------------------------------------------- datasets
+
+
+class TripletDataset(TorchDataset):
+    """The triplets of one split; item ``i`` is triplet ``i`` as a :class:`TripletItem`.
+
+    Construction reads only the triplet table and the ``obs_id`` column of the split's
+    observation shards (to index every view by id, and to check every triplet's views
+    exist). Each process that reads items (the main one, or each ``DataLoader`` worker) loads
+    the image, objects and relations columns of a room shard on its first view from it and
+    keeps them (images still encoded) for later items; images are decoded per item. Memory
+    per reading process is therefore about the size of the split's observation files.
+
+    Args:
+        root: the dataset directory.
+        split: ``train``, ``val`` or ``test``.
+        transform: image size and normalisation (default 224 px, ImageNet statistics).
+
+    Raises:
+        DataError: the dataset or split is missing or malformed, or a triplet names an
+            observation the split does not hold.
+    """
+
+    def __init__(
+        self, root: str | Path, split: str, *, transform: ImageTransform | None = None
+    ) -> None:
+        ds = open_dataset(root)
+        self.root = Path(root)
+        self.split = split
+        self.transform = transform or ImageTransform()
+        self.identity = dataset_identity(ds)
+        table = _call(ds.triplets, split)
+        self._store = _ViewStore(ds, split, self.transform)
+        self.triplet_ids = table.column("triplet_id").to_numpy().astype(np.int64)
+        self.tiers = table.column("tier").to_numpy().astype(np.int64)
+        self.room_ids: list[str] = table.column("room_id").to_pylist()
+        names = ("anchor", "positive", "negative")
+        ids = [table.column(n).to_pylist() for n in names]
+        self.obs: list[tuple[str, str, str]] = list(zip(*ids, strict=True))
+        locs = []
+        for k, triple in enumerate(self.obs):
+            try:
+                locs.append(tuple(self._store.locate(o) for o in triple))
+            except DataError as exc:
+                raise DataError(f"triplet {int(self.triplet_ids[k])} of {split}: {exc}") from None
+        self._locations: list[tuple[tuple[int, int], ...]] = locs
+
+    def __len__(self) -> int:
+        return len(self.obs)
+
+    def __getitem__(self, i: int) -> TripletItem:
+        if not -len(self) <= i < len(self):
+            raise IndexError(f"triplet index {i} out of range for {len(self)} triplets")
+        a, p, n = (self._store.view(f, r) for f, r in self._locations[i])
+        return TripletItem(
+            anchor=a,
+            positive=p,
+            negative=n,
+            tier=int(self.tiers[i]),
+            triplet_id=int(self.triplet_ids[i]),
+            room_id=self.room_ids[i],
+            ids=self.obs[i],
+        )
+
+
+class ObservationDataset(TorchDataset):
+    """Every observation of one split, once (to embed all views for evaluation).
+
+    Items are in storage order (manifest room order, then row order) as
+    :class:`ObservationItem`; files are read lazily per process as in :class:`TripletDataset`.
+
+    Args:
+        root: the dataset directory.
+        split: ``train``, ``val`` or ``test``.
+        transform: image size and normalisation (default 224 px, ImageNet statistics).
+
+    Raises:
+        DataError: the dataset or split is missing or malformed.
+    """
+
+    def __init__(
+        self, root: str | Path, split: str, *, transform: ImageTransform | None = None
+    ) -> None:
+        ds = open_dataset(root)
+        self.root = Path(root)
+        self.split = split
+        self.transform = transform or ImageTransform()
+        self.identity = dataset_identity(ds)
+        self._store = _ViewStore(ds, split, self.transform)
+
+    def __len__(self) -> int:
+        return len(self._store.obs_ids)
+
+    @property
+    def obs_ids(self) -> list[str]:
+        """Observation ids in item order."""
+        return list(self._store.obs_ids)
+
+    def __getitem__(self, i: int) -> ObservationItem:
+        if not -len(self) <= i < len(self):
+            raise IndexError(f"observation index {i} out of range for {len(self)} views")
+        i = i % len(self)
+        f, r = self._store.locations[i]
+        m = self._store.meta
+        return ObservationItem(
+            view=self._store.view(f, r),
+            obs_id=self._store.obs_ids[i],
+            room_id=m["room_id"][i],
+            layout=int(m["layout"][i]),
+            grid_i=m["grid_i"][i],
+            grid_j=m["grid_j"][i],
+            heading=m["heading"][i],
+        )
+
+
+# ---------------------------------------------------------------------------------- collation
+
+
+def _scene_batch(views: Sequence[ViewTensors]) -> SceneBatch:
+    """Stack images and adjacency; concatenate boxes with the view index of each."""
+    counts = torch.tensor([v.boxes.shape[0] for v in views], dtype=torch.long)
+    return SceneBatch(
+        images=torch.stack([v.image for v in views]),
+        boxes=torch.cat([v.boxes.reshape(-1, 4) for v in views]),
+        box_view=torch.repeat_interleave(torch.arange(len(views)), counts),
+        class_ids=torch.cat([v.class_ids for v in views]),
+        slots=torch.cat([v.slots for v in views]),
+        adjacency=torch.stack([v.adjacency for v in views]),
+    )
+
+
+def collate_triplets(
+    items: Sequence[TripletItem],
+) -> tuple[SceneBatch, SceneBatch, SceneBatch, dict[str, Any]]:
+    """Batch triplets as ``(anchors, positives, negatives, meta)`` (the ``collate_fn``).
+
+    Row b of each of the three batches is triplet b. ``meta`` holds ``tier`` and
+    ``triplet_id`` ((B,) long tensors), ``room_id`` and ``anchor`` / ``positive`` /
+    ``negative`` obs ids (lists of str).
+    """
+    if not items:
+        raise DataError("collate_triplets: no items; expected at least one triplet")
+    meta: dict[str, Any] = {
+        "tier": torch.tensor([t.tier for t in items], dtype=torch.long),
+        "triplet_id": torch.tensor([t.triplet_id for t in items], dtype=torch.long),
+        "room_id": [t.room_id for t in items],
+        "anchor": [t.ids[0] for t in items],
+        "positive": [t.ids[1] for t in items],
+        "negative": [t.ids[2] for t in items],
+    }
+    return (
+        _scene_batch([t.anchor for t in items]),
+        _scene_batch([t.positive for t in items]),
+        _scene_batch([t.negative for t in items]),
+        meta,
+    )
+
+
+def collate_views(
+    items: Sequence[ObservationItem | ViewTensors],
+) -> tuple[SceneBatch, dict[str, Any]]:
+    """Batch single views as ``(batch, meta)`` (the ``collate_fn`` of ObservationDataset).
+
+    ``meta`` holds ``obs_id`` and ``room_id`` (lists of str) and ``layout``, ``grid_i``,
+    ``grid_j``, ``heading`` ((B,) long tensors; -1 where the field is null, as for an unposed
+    photo). Bare :class:`ViewTensors` items give an empty ``meta``.
+    """
+    if not items:
+        raise DataError("collate_views: no items; expected at least one view")
+    if all(isinstance(x, ViewTensors) for x in items):
+        return _scene_batch(list(items)), {}
+    if not all(isinstance(x, ObservationItem) for x in items):
+        raise DataError("collate_views: items mix ObservationItem and ViewTensors")
+
+    def ints(name: str) -> Tensor:
+        values = [getattr(x, name) for x in items]
+        return torch.tensor([-1 if v is None else int(v) for v in values], dtype=torch.long)
+
+    meta: dict[str, Any] = {
+        "obs_id": [x.obs_id for x in items],
+        "room_id": [x.room_id for x in items],
+        **{name: ints(name) for name in ("layout", "grid_i", "grid_j", "heading")},
+    }
+    return _scene_batch([x.view for x in items]), meta
