@@ -14,13 +14,15 @@ __all__ = ["run_app"]
 EXIT_USER_ERROR = 2
 
 
-def run_app(app: typer.Typer, prog_name: str) -> Callable[[], None]:
-    """A console-script entry point running ``app`` with one-line error reporting."""
+def run_app(
+    app: typer.Typer, prog_name: str, *, errors: tuple[type[Exception], ...] = (SgdataError,)
+) -> Callable[[], None]:
+    """A console-script entry point running ``app``; ``errors`` become one line + exit 2."""
 
     def main() -> None:
         try:
             app(prog_name=prog_name, standalone_mode=True)
-        except SgdataError as exc:
+        except errors as exc:
             print(f"{prog_name}: error: {exc}", file=sys.stderr)
             sys.exit(EXIT_USER_ERROR)
         except KeyboardInterrupt:

@@ -195,6 +195,60 @@ def render(
     )
 
 
+@app.command()
+def validate(
+    root: Annotated[Path, typer.Argument(help="Dataset root (holding dataset.json).")],
+    json_out: Annotated[
+        bool, typer.Option("--json", help="Print the report as JSON on stdout.")
+    ] = False,
+    quick: Annotated[bool, typer.Option(help="Skip decoding the images.")] = False,
+    usd: Annotated[bool, typer.Option(help="Also run USD's validators on the scenes.")] = False,
+    show: Annotated[int, typer.Option(help="Problems to list in the summary.")] = 20,
+) -> None:
+    """Check a dataset against its format; exit 0 only when every check passes."""
+    from sgdata.validate import validate_dataset
+
+    report = validate_dataset(root, quick=quick, usd=usd)
+    if json_out:
+        print(report.to_json())
+    else:
+        table = Table(title=f"sgdata validate {root} ({report.elapsed:.1f} s)")
+        for column in ("check", "checked", "failures"):
+            table.add_column(column, justify="left" if column == "check" else "right")
+        for name, failures in report.failures().items():
+            style = "red" if failures else None
+            table.add_row(name, str(report.checked.get(name, 0)), str(failures), style=style)
+        for name in report.skipped:
+            table.add_row(name, "skipped", "-", style="dim")
+        console.print(table)
+        for problem in report.problems[:show]:
+            console.print(
+                f"{problem.location()}: [{problem.check}] {problem.message}", markup=False
+            )
+        if len(report.problems) > show:
+            console.print(f"... and {len(report.problems) - show} more (--json lists all)")
+        console.print("clean" if report.ok else f"{len(report.problems)} problem(s)")
+    if not report.ok:
+        raise typer.Exit(1)
+
+
+@app.command()
+def report(
+    root: Annotated[Path, typer.Argument(help="Dataset root (holding dataset.json).")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Directory to write into.")] = Path(
+        "report"
+    ),
+    triplets: Annotated[int, typer.Option(help="Random triplets on the contact sheet.")] = 6,
+    seed: Annotated[int, typer.Option(help="Seed of the triplet draw.")] = 0,
+) -> None:
+    """Write histograms, a contact sheet of random triplets and summary.md for a dataset."""
+    from sgdata.report import write_report
+
+    written = write_report(root, output, triplets=triplets, seed=seed)
+    for path in written:
+        console.print(f"wrote {path}")
+
+
 main = run_app(app, "sgdata")
 
 if __name__ == "__main__":

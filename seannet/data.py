@@ -215,7 +215,7 @@ def graph_tensors(
     """
     obj = _struct_columns(objects, ("instance", "class_id", "slot", "box2d"))
     rel = _struct_columns(relations, ("src", "dst", "type"))
-    return _graph_from_columns(
+    slots, class_ids, boxes, edge_index, edge_weight = _graph_from_columns(
         obj["instance"],
         obj["class_id"],
         obj["slot"],
@@ -225,6 +225,14 @@ def graph_tensors(
         rel["type"],
         num_slots,
     )
+    return slots, class_ids, boxes, _dense(edge_index, edge_weight, num_slots)
+
+
+def _dense(edge_index: Tensor, edge_weight: Tensor, num_slots: int) -> Tensor:
+    """(3, M, M) adjacency from (3, E) [relation, src slot, dst slot] and (E,) weights."""
+    adjacency = torch.zeros((NUM_RELATIONS, num_slots, num_slots), dtype=torch.float32)
+    adjacency[edge_index[0], edge_index[1], edge_index[2]] = edge_weight
+    return adjacency
 
 
 def _graph_from_columns(
@@ -236,8 +244,14 @@ def _graph_from_columns(
     dst: np.ndarray,
     rtype: np.ndarray,
     num_slots: int,
-) -> tuple[Tensor, Tensor, Tensor, Tensor]:
-    """:func:`graph_tensors` on numpy columns (the datasets' fast path)."""
+) -> tuple[Tensor, Tensor, Tensor, Tensor, Tensor]:
+    """:func:`graph_tensors` on numpy columns, the adjacency as a sparse edge list.
+
+    Returns:
+        ``(slots, class_ids, boxes, edge_index, edge_weight)``: edge_index (3, E) long holds
+        [relation, src slot, dst slot] of each distinct fed edge, edge_weight (E,) float32 its
+        row-normalised value (1 / out-degree of the source in that relation).
+    """
     m = num_slots
     slot = np.asarray(slot, dtype=np.int64)
     if slot.size and (slot.min() < 0 or slot.max() >= m):
@@ -245,9 +259,10 @@ def _graph_from_columns(
         raise DataError(f"object slot {bad} out of range; expected 0 <= slot < {m}")
     if np.unique(slot).size != slot.size:
         raise DataError("two objects of one view share a GCN slot; slots must be unique")
-    adjacency = np.zeros((NUM_RELATIONS, m, m), dtype=np.float32)
     rtype = np.asarray(rtype, dtype=np.int64)
     fed = rtype < NUM_RELATIONS  # 'disjoint' and any later type are not GCN pathways
+    edge_index = np.zeros((3, 0), dtype=np.int64)
+    edge_weight = np.zeros(0, dtype=np.float32)
     if fed.any():
         instance = np.asarray(instance, dtype=np.int64)
         order = np.argsort(instance, kind="stable")
@@ -261,15 +276,18 @@ def _graph_from_columns(
             raise DataError(f"a relation names instance {missing}, not among the row's objects")
         ends_slot = slot[order][pos]
         n = int(fed.sum())
-        adjacency[rtype[fed], ends_slot[:n], ends_slot[n:]] = 1.0
-        rowsum = adjacency.sum(axis=2, keepdims=True)
-        np.divide(adjacency, rowsum, out=adjacency, where=rowsum > 0)
-    boxes = np.asarray(box2d, dtype=np.float32).reshape(-1, 4)
+        # distinct (relation, src, dst) cells, then 1 / out-degree per (relation, src) row
+        cell = np.unique((rtype[fed] * m + ends_slot[:n]) * m + ends_slot[n:])
+        row = cell // m
+        _, inverse, degree = np.unique(row, return_inverse=True, return_counts=True)
+        edge_index = np.stack((row // m, row % m, cell % m))
+        edge_weight = (1.0 / degree[inverse]).astype(np.float32)
     return (
         torch.from_numpy(slot),
         torch.from_numpy(np.asarray(class_id, dtype=np.int64)),
-        torch.from_numpy(boxes),
-        torch.from_numpy(adjacency),
+        torch.from_numpy(np.asarray(box2d, dtype=np.float32).reshape(-1, 4)),
+        torch.from_numpy(edge_index),
+        torch.from_numpy(edge_weight),
     )
 
 
@@ -285,14 +303,27 @@ class ViewTensors:
         boxes: (K, 4) float32 pixel boxes in the S x S frame.
         class_ids: (K,) long.
         slots: (K,) long.
-        adjacency: (3, M, M) float32, row-normalised on / in / proximity.
+        edge_index: (3, E) long, [relation, src slot, dst slot] of each non-zero adjacency
+            cell (relation 0 on, 1 in, 2 proximity).
+        edge_weight: (E,) float32, the row-normalised value of each cell.
+        num_slots: M.
+
+    The adjacency travels sparse (a dense one is 3 x M x M floats, 786 KB at M = 256) and is
+    made dense once per batch by the collate functions; :attr:`adjacency` gives it per view.
     """
 
     image: Tensor
     boxes: Tensor
     class_ids: Tensor
     slots: Tensor
-    adjacency: Tensor
+    edge_index: Tensor
+    edge_weight: Tensor
+    num_slots: int
+
+    @property
+    def adjacency(self) -> Tensor:
+        """(3, M, M) float32, row-normalised on / in / proximity (absent nodes: zero rows)."""
+        return _dense(self.edge_index, self.edge_weight, self.num_slots)
 
 
 @dataclass
@@ -418,7 +449,7 @@ class _ViewStore:
         r0, r1 = s.rel_offsets[row], s.rel_offsets[row + 1]
         obs = self.obs_ids_of(f, row)
         try:
-            slots, class_ids, boxes, adjacency = _graph_from_columns(
+            slots, class_ids, boxes, edge_index, edge_weight = _graph_from_columns(
                 s.instance[o0:o1],
                 s.class_id[o0:o1],
                 s.slot[o0:o1],
@@ -432,7 +463,7 @@ class _ViewStore:
         except (DataError, DatasetError) as exc:
             raise DataError(f"observation {obs!r}: {exc}") from None
         image, boxes = self.transform(rgb, boxes.numpy())
-        return ViewTensors(image, boxes, class_ids, slots, adjacency)
+        return ViewTensors(image, boxes, class_ids, slots, edge_index, edge_weight, self.num_slots)
 
     def obs_ids_of(self, f: int, row: int) -> str:
         return self.obs_ids[int(self.file_starts[f]) + row]
@@ -567,13 +598,22 @@ class ObservationDataset(TorchDataset):
 def _scene_batch(views: Sequence[ViewTensors]) -> SceneBatch:
     """Stack images and adjacency; concatenate boxes with the view index of each."""
     counts = torch.tensor([v.boxes.shape[0] for v in views], dtype=torch.long)
+    m = views[0].num_slots
+    if any(v.num_slots != m for v in views):
+        raise DataError(f"views with {sorted({v.num_slots for v in views})} slots in one batch")
+    adjacency = torch.zeros((len(views), NUM_RELATIONS, m, m), dtype=torch.float32)
+    edges = torch.cat([v.edge_index for v in views], dim=1)
+    edge_view = torch.repeat_interleave(
+        torch.arange(len(views)), torch.tensor([v.edge_index.shape[1] for v in views])
+    )
+    adjacency[edge_view, edges[0], edges[1], edges[2]] = torch.cat([v.edge_weight for v in views])
     return SceneBatch(
         images=torch.stack([v.image for v in views]),
         boxes=torch.cat([v.boxes.reshape(-1, 4) for v in views]),
         box_view=torch.repeat_interleave(torch.arange(len(views)), counts),
         class_ids=torch.cat([v.class_ids for v in views]),
         slots=torch.cat([v.slots for v in views]),
-        adjacency=torch.stack([v.adjacency for v in views]),
+        adjacency=adjacency,
     )
 
 

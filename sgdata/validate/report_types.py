@@ -1,4 +1,4 @@
-"""What a validation run returns: one :class:`Problem` per failure and a :class:`ValidationReport`."""
+"""What a validation run returns: a :class:`Problem` per failure, a :class:`ValidationReport`."""
 
 from __future__ import annotations
 
@@ -92,4 +92,6 @@ class Collector:
     ) -> None:
         """Record one problem."""
         self.checked[check] += 0  # a check that failed is listed even if it counted nothing
-        self.problems.append(Problem(check, file, None if row is None else int(row), field, message))
+        self.problems.append(
+            Problem(check, file, None if row is None else int(row), field, message)
+        )

@@ -29,12 +29,34 @@ def _type_name(t: pa.DataType) -> str:
     return str(t)
 
 
-def _children(t: pa.DataType) -> list[pa.Field] | None:
-    if pa.types.is_struct(t):
-        return [t.field(i) for i in range(t.num_fields)]
-    if pa.types.is_list(t) or pa.types.is_fixed_size_list(t) or pa.types.is_large_list(t):
-        return [t.value_field]
-    return None
+def _compare_type(found: pa.DataType, wanted: pa.DataType, name: str) -> list[tuple[str, str]]:
+    mismatch = [(name, f"type {_type_name(found)}; expected {_type_name(wanted)}")]
+    if pa.types.is_struct(wanted):
+        if not pa.types.is_struct(found):
+            return mismatch
+        return _compare_fields(
+            [found.field(i) for i in range(found.num_fields)],
+            [wanted.field(i) for i in range(wanted.num_fields)],
+            f"{name}.",
+            extra_ok=False,
+        )
+    if pa.types.is_fixed_size_list(wanted) or pa.types.is_list(wanted):
+        same = (
+            pa.types.is_fixed_size_list(found) and found.list_size == wanted.list_size
+            if pa.types.is_fixed_size_list(wanted)
+            else pa.types.is_list(found)
+        )
+        if not same:
+            return mismatch
+        fe, we = found.value_field, wanted.value_field
+        out = []
+        if fe.nullable != we.nullable:
+            out.append((f"{name}[]", f"elements nullable={fe.nullable}; expected {we.nullable}"))
+        inner = _compare_type(fe.type, we.type, f"{name}[]")
+        if inner and not pa.types.is_struct(we.type):
+            return out + mismatch  # report a wrong element type as the column's type
+        return out + inner
+    return [] if found.equals(wanted) else mismatch
 
 
 def _compare_fields(
@@ -52,36 +74,7 @@ def _compare_fields(
         if f.nullable != w.nullable:
             expected = "nullable" if w.nullable else "not nullable"
             out.append((name, f"nullable={f.nullable}; expected {expected}"))
-        fc, wc = _children(f.type), _children(w.type)
-        same_kind = (
-            wc is not None
-            and fc is not None
-            and _type_name(f.type).split("<")[0].split("[")[-1]
-            == _type_name(w.type).split("<")[0].split("[")[-1]
-            and (not pa.types.is_fixed_size_list(w.type) or f.type == w.type or
-                 (pa.types.is_fixed_size_list(f.type) and f.type.list_size == w.type.list_size))
-        )
-        if wc is None or fc is None or not same_kind:
-            if not f.type.equals(w.type):
-                out.append((name, f"type {_type_name(f.type)}; expected {_type_name(w.type)}"))
-            continue
-        sep = "." if pa.types.is_struct(w.type) else "[]"
-        if sep == "[]":  # list element: compare its type and nullability, then recurse
-            fe, we = fc[0], wc[0]
-            if fe.nullable != we.nullable:
-                out.append((f"{name}[]", f"elements nullable={fe.nullable}; expected not"))
-            sub = _children(we.type)
-            if sub is None:
-                if not fe.type.equals(we.type):
-                    out.append(
-                        (name, f"type {_type_name(f.type)}; expected {_type_name(w.type)}")
-                    )
-            elif _children(fe.type) is None or not pa.types.is_struct(fe.type):
-                out.append((name, f"type {_type_name(f.type)}; expected {_type_name(w.type)}"))
-            else:
-                out.extend(_compare_fields(_children(fe.type), sub, f"{name}[].", extra_ok=False))
-        else:
-            out.extend(_compare_fields(fc, wc, f"{name}.", extra_ok=False))
+        out.extend(_compare_type(f.type, w.type, name))
     if not extra_ok:
         known = {w.name for w in wanted}
         out.extend(
@@ -92,7 +85,9 @@ def _compare_fields(
     return out
 
 
-def compare_schema(found: pa.Schema, wanted: pa.Schema, *, extra_ok: bool = False) -> list[tuple[str, str]]:
+def compare_schema(
+    found: pa.Schema, wanted: pa.Schema, *, extra_ok: bool = False
+) -> list[tuple[str, str]]:
     """Differences between a file's schema and the format's: ``(field path, message)`` each.
 
     ``extra_ok``: columns beyond the format's are allowed (a newer minor format adds them).
@@ -113,7 +108,9 @@ def _schema_check(root: Path, rel: str, wanted: pa.Schema, out: Collector, extra
     return not diffs
 
 
-def load_split(root: Path, raw: dict[str, Any], split: str, out: Collector, *, extra_ok: bool) -> SplitTables:
+def load_split(
+    root: Path, raw: dict[str, Any], split: str, out: Collector, *, extra_ok: bool
+) -> SplitTables:
     """Schema-check and read one split's shards (no images) and triplet table."""
     obs_schema = observations_schema()
     tables, files, file_index, file_row = [], [], [], []

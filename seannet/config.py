@@ -1,0 +1,84 @@
+"""Training configuration: presets (``cpu``, ``paper``) as frozen dataclasses."""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import Any
+
+from .errors import ModelError
+
+__all__ = ["PRESETS", "TrainConfig", "preset"]
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    """Everything a training run depends on; stored in every checkpoint."""
+
+    model: str = (
+        "seannet"  # seannet | resnet18 | resnet34 | resnet50 | resnext50 | vgg16 | googlenet
+    )
+    depth: int = 50  # SeanNet's ResNet depth (18 / 34 / 50)
+    image_size: int = 224  # square input size; boxes are scaled with the image
+    roi_size: int = 14  # RoIAlign output; 14 on the 14 x 14 C4 map of a 224 input
+    embed_dim: int = 2048
+    dropout: float = 0.2  # on the GCN layers (paper §V-B)
+    epochs: int = 60
+    batch_size: int = 14  # the paper's SeanNet batch
+    lr: float = 0.01  # SGD (paper §V-B)
+    momentum: float = 0.9
+    lr_decay: float = 0.7  # x0.7 ...
+    decay_every: int = 10  # ... every 10 epochs
+    margin: float = 0.1  # triplet loss margin
+    num_workers: int = 2  # DataLoader workers
+    max_train_batches: int = 0  # per epoch; 0 = the whole split (a CPU budget knob)
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        positive = ("depth", "image_size", "roi_size", "embed_dim", "epochs", "batch_size")
+        for name in positive:
+            if getattr(self, name) < 1:
+                raise ModelError(f"train.{name} must be >= 1, got {getattr(self, name)}")
+        if self.depth not in (18, 34, 50):
+            raise ModelError(f"train.depth {self.depth}: expected 18, 34 or 50")
+        if not 0.0 <= self.dropout < 1.0:
+            raise ModelError(f"train.dropout must be within [0, 1), got {self.dropout}")
+        if self.lr <= 0 or self.margin < 0 or self.decay_every < 1 or self.num_workers < 0:
+            raise ModelError("train: lr > 0, margin >= 0, decay_every >= 1, num_workers >= 0")
+
+    def replace(self, **changes: Any) -> TrainConfig:
+        """A copy with some fields changed (validated again)."""
+        return dataclasses.replace(self, **changes)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain form for checkpoints and reports."""
+        return dataclasses.asdict(self)
+
+
+PRESETS: dict[str, TrainConfig] = {
+    # The paper: ResNet-50 at 224 px, 60 epochs, SGD 0.01 x0.7 every 10 epochs, margin 0.1.
+    "paper": TrainConfig(),
+    # Two CPU cores in about half an hour: ResNet-18 at 112 px (C4 7 x 7, RoIAlign 7), a
+    # shortened schedule with the paper's decay shape, and a fixed number of batches per epoch.
+    "cpu": TrainConfig(
+        depth=18,
+        image_size=112,
+        roi_size=7,
+        epochs=12,
+        batch_size=16,
+        decay_every=4,
+        max_train_batches=40,
+    ),
+}
+
+
+def preset(name: str) -> TrainConfig:
+    """A preset by name.
+
+    Raises:
+        ModelError: unknown preset.
+    """
+    try:
+        return PRESETS[name]
+    except KeyError:
+        raise ModelError(f"unknown preset {name!r}; expected one of {', '.join(PRESETS)}") from None

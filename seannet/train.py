@@ -1,0 +1,207 @@
+"""The trainer: triplet loss on a dataset's cascaded triplets, validation every epoch.
+
+Resumable at epoch boundaries and exactly so: every epoch draws its batch order and its
+dropout masks from seeds derived from the config seed and the epoch, never from state carried
+over from earlier epochs, so a run resumed after a kill continues as if never stopped.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import torch
+from torch.utils.data import DataLoader, Subset
+
+from sgdata.fileio import atomic_write_text
+from sgdata.seeds import derive_seed
+
+from .checkpoint import check_same_dataset, load_checkpoint, save_checkpoint
+from .config import TrainConfig
+from .data import ImageTransform, TripletDataset, collate_triplets, dataset_identity, open_dataset
+from .errors import CheckpointError
+from .loss import TripletLoss, similarity
+from .model import build_model
+
+__all__ = ["EpochResult", "train", "build_for_dataset", "device_for_run"]
+
+LAST, BEST, HISTORY = "last.pt", "best.pt", "history.json"
+
+
+@dataclass(frozen=True)
+class EpochResult:
+    """What one epoch did."""
+
+    epoch: int
+    train_loss: float
+    train_accuracy: float
+    val_accuracy: float
+    lr: float
+    seconds: float
+
+
+def device_for_run() -> torch.device:
+    """CUDA when present, else the CPU."""
+    return torch.device("cuda" if torch.cuda.is_available() else "cpu")
+
+
+def build_for_dataset(config: TrainConfig, root: Path, *, pretrained: Path | None = None):  # noqa: ANN201
+    """The model of ``config`` sized for the dataset at ``root`` (its class vocabulary, M)."""
+    dataset = open_dataset(root)
+    return build_model(
+        config.model,
+        depth=config.depth,
+        num_slots=dataset.manifest.num_slots,
+        class_names=list(dataset.class_names),
+        roi_size=config.roi_size,
+        embed_dim=config.embed_dim,
+        dropout=config.dropout,
+        pretrained=pretrained,
+    )
+
+
+def train(
+    config: TrainConfig,
+    data: Path,
+    out: Path,
+    *,
+    resume: bool = False,
+    pretrained: Path | None = None,
+    progress: Callable[[str, int, int, dict[str, float]], None] | None = None,
+) -> list[EpochResult]:
+    """Train ``config.model`` on ``data`` into the run directory ``out``.
+
+    Writes ``last.pt`` after every epoch, ``best.pt`` when validation accuracy improves and
+    ``history.json``. ``progress(phase, step, total, metrics)`` is called per batch.
+
+    Raises:
+        CheckpointError: ``resume`` without a checkpoint, a different config, or a different
+            dataset than the checkpoint's; ``out`` holds a run and ``resume`` is off.
+        DataError: the dataset is missing or malformed.
+    """
+    identity = dataset_identity(data)
+    transform = ImageTransform(size=config.image_size)
+    train_set = TripletDataset(data, "train", transform=transform)
+    val_set = TripletDataset(data, "val", transform=transform)
+    device = device_for_run()
+    model = build_for_dataset(config, data, pretrained=pretrained).to(device)
+    optimizer = torch.optim.SGD(model.parameters(), lr=config.lr, momentum=config.momentum)
+    schedule = torch.optim.lr_scheduler.StepLR(optimizer, config.decay_every, config.lr_decay)
+    history: list[dict[str, Any]] = []
+    best = -1.0
+    start_epoch = 0
+    last = out / LAST
+    if resume:
+        state = load_checkpoint(last)
+        check_same_dataset(last, state["dataset"], identity)
+        if state["config"] != config.to_dict():
+            raise CheckpointError(f"{last}: was trained with another config; resume with that one")
+        model.load_state_dict(state["model"])
+        optimizer.load_state_dict(state["optimizer"])
+        schedule.load_state_dict(state["schedule"])
+        history, best, start_epoch = state["history"], state["best"], state["epoch"] + 1
+    elif last.exists():
+        raise CheckpointError(f"{out}: holds a run already; pass --resume or pick another --out")
+    out.mkdir(parents=True, exist_ok=True)
+    loss_fn = TripletLoss(config.margin)
+    results = [EpochResult(**h) for h in history]
+    for epoch in range(start_epoch, config.epochs):
+        started = time.perf_counter()
+        lr = optimizer.param_groups[0]["lr"]
+        loss, accuracy = _train_epoch(
+            config, model, train_set, optimizer, loss_fn, epoch, device, progress
+        )
+        val_accuracy = evaluate_triplets(config, model, val_set, device, progress)
+        schedule.step()
+        result = EpochResult(epoch, loss, accuracy, val_accuracy, lr, time.perf_counter() - started)
+        results.append(result)
+        history.append(result.__dict__)
+        state = {
+            "config": config.to_dict(),
+            "dataset": identity,
+            "epoch": epoch,
+            "model": model.state_dict(),
+            "optimizer": optimizer.state_dict(),
+            "schedule": schedule.state_dict(),
+            "history": history,
+            "best": max(best, val_accuracy),
+        }
+        if val_accuracy > best:
+            best = val_accuracy
+            save_checkpoint(out / BEST, state)
+        save_checkpoint(last, state)
+        atomic_write_text(out / HISTORY, json.dumps(history, indent=2))
+    return results
+
+
+def _train_epoch(
+    config: TrainConfig,
+    model: torch.nn.Module,
+    dataset: TripletDataset,
+    optimizer: torch.optim.Optimizer,
+    loss_fn: TripletLoss,
+    epoch: int,
+    device: torch.device,
+    progress: Callable[[str, int, int, dict[str, float]], None] | None,
+) -> tuple[float, float]:
+    order = torch.Generator().manual_seed(derive_seed(config.seed, epoch, 0))
+    indices = torch.randperm(len(dataset), generator=order).tolist()
+    if config.max_train_batches:
+        indices = indices[: config.max_train_batches * config.batch_size]
+    torch.manual_seed(derive_seed(config.seed, epoch, 1))  # dropout masks of this epoch
+    loader = DataLoader(
+        Subset(dataset, indices),
+        batch_size=config.batch_size,
+        collate_fn=collate_triplets,
+        num_workers=config.num_workers,
+        persistent_workers=False,
+    )
+    model.train()
+    total_loss = correct = seen = 0.0
+    for step, (anchor, positive, negative, _) in enumerate(loader, 1):
+        a = model.embed(anchor.to(device))
+        p = model.embed(positive.to(device))
+        n = model.embed(negative.to(device))
+        loss = loss_fn(a, p, n)  # (A, P, N): the authors' baselines were fed (A, N, P)
+        optimizer.zero_grad(set_to_none=True)
+        loss.backward()
+        optimizer.step()
+        with torch.no_grad():
+            correct += float((similarity(a, p) > similarity(a, n)).sum())
+        total_loss += float(loss) * len(a)
+        seen += len(a)
+        if progress is not None:
+            progress("train", step, len(loader), {"loss": total_loss / seen, "acc": correct / seen})
+    return total_loss / max(seen, 1), correct / max(seen, 1)
+
+
+@torch.no_grad()
+def evaluate_triplets(
+    config: TrainConfig,
+    model: torch.nn.Module,
+    dataset: TripletDataset,
+    device: torch.device,
+    progress: Callable[[str, int, int, dict[str, float]], None] | None = None,
+) -> float:
+    """Share of triplets with S(A, P) > S(A, N)."""
+    loader = DataLoader(
+        dataset,
+        batch_size=config.batch_size,
+        collate_fn=collate_triplets,
+        num_workers=config.num_workers,
+    )
+    model.eval()
+    correct = seen = 0
+    for step, (anchor, positive, negative, _) in enumerate(loader, 1):
+        a = model.embed(anchor.to(device))
+        p = model.embed(positive.to(device))
+        n = model.embed(negative.to(device))
+        correct += int((similarity(a, p) > similarity(a, n)).sum())
+        seen += len(a)
+        if progress is not None:
+            progress("val", step, len(loader), {"acc": correct / seen})
+    return correct / max(seen, 1)

@@ -1,0 +1,81 @@
+"""``sgdata validate``: check a dataset on disk against its format and collect every problem.
+
+One entry point, :func:`validate_dataset`, runs the check families in order (see
+docs/validate.md): manifest, files, tables, rows/objects/relations, relation recompute,
+triplets, images, scenes. Nothing stops at the first failure: the report lists every
+:class:`Problem` with its file, row and field.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from ..schema import FORMAT_VERSION, _parse_version
+from .composition_checks import check_rooms_across_splits, check_triplets
+from .image_checks import check_images
+from .logic_checks import check_objects, check_relations, check_rows
+from .manifest_checks import check_files, check_manifest, check_splits, read_raw_manifest
+from .relation_checks import check_recompute
+from .report_types import Collector, Problem, ValidationReport
+from .scene_checks import check_scenes
+from .table_checks import check_ids, compare_schema, load_split
+
+__all__ = ["Problem", "ValidationReport", "compare_schema", "validate_dataset"]
+
+
+def validate_dataset(
+    root: str | Path, *, quick: bool = False, usd: bool = False
+) -> ValidationReport:
+    """Check the dataset at ``root``; every failure becomes a :class:`Problem`.
+
+    Args:
+        root: the dataset directory (holding ``dataset.json``).
+        quick: skip decoding the images (the slowest check).
+        usd: also run USD's validators on every referenced scene layer.
+
+    Returns:
+        the report; ``report.ok`` is True only when no check failed.
+
+    Raises:
+        DatasetError: ``root`` is not a directory or has no ``dataset.json`` (not a dataset).
+    """
+    start = time.perf_counter()
+    root = Path(root)
+    out = Collector()
+    raw = read_raw_manifest(root, out)
+    if raw is not None and check_manifest(raw, out):
+        _check_contents(root, raw, out, quick=quick, usd=usd)
+    if quick:
+        out.skipped.append("images.decode")
+        out.skipped.append("images.size")
+    if not usd:
+        out.skipped.append("scenes.usd")
+    return ValidationReport(
+        root=str(root),
+        problems=out.problems,
+        checked=dict(out.checked),
+        skipped=out.skipped,
+        elapsed=time.perf_counter() - start,
+    )
+
+
+def _check_contents(root: Path, raw: dict, out: Collector, *, quick: bool, usd: bool) -> None:
+    check_splits(raw, out)
+    check_files(root, raw, out)
+    newer = _parse_version(raw["format_version"])[:2] > _parse_version(FORMAT_VERSION)[:2]
+    splits = []
+    for split in raw["splits"]:
+        tables = load_split(root, raw, split, out, extra_ok=newer)
+        splits.append(tables)
+        check_ids(tables, out)
+        check_rows(tables, raw, out)
+        objects = check_objects(tables, raw, out)
+        if objects is not None:
+            relations = check_relations(tables, raw, objects, out)
+            check_recompute(tables, raw, objects, relations, out)
+        check_triplets(tables, raw, out)
+        if not quick:
+            check_images(root, tables.files, out)
+    check_rooms_across_splits(splits, out)
+    check_scenes(root, splits, out, usd=usd)

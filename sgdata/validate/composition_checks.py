@@ -1,0 +1,202 @@
+"""Composition checks on the triplet tables: references into the split, no triplet across
+rooms or splits, tier shares (DESIGN §6), offsets recomputed from the grid poses against the
+tier rules and the stored offsets; rooms never shared by two splits' observations."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.compute as pc
+
+from ..dataset.layout import MANIFEST
+from ..triplets import TIERS, tier_counts
+from .loading import SplitTables, column_numpy, fixed_numpy
+from .report_types import Collector
+
+__all__ = ["check_triplets", "check_rooms_across_splits", "ROLES"]
+
+ROLES = ("anchor", "positive", "negative")
+_POINT = 0.01  # shares must hold within ±1 percentage point (DESIGN §6)
+
+
+def _shares(raw: dict[str, Any]) -> list[float]:
+    shares = raw.get("config", {}).get("triplets", {}).get("shares")
+    return list(shares) if shares else [t.share for t in TIERS]
+
+
+def check_triplets(tables: SplitTables, raw: dict[str, Any], out: Collector) -> None:
+    """Every triplet rule for one split."""
+    tri = tables.triplets
+    if tri is None:
+        return
+    file, split = tables.triplets_file, tables.split
+    n = tri.num_rows
+
+    def report(check: str, bad: np.ndarray, field: str, message: Any) -> None:
+        for r in np.flatnonzero(bad):
+            text = message(r) if callable(message) else message
+            out.add(check, file, text, row=int(r), field=field)
+
+    out.count("triplets.ids", n)
+    ids = column_numpy(tri, "triplet_id")
+    report(
+        "triplets.ids",
+        ids != np.arange(n),
+        "triplet_id",
+        lambda r: f"{ids[r]}; expected the row index {r}",
+    )
+    tsplit = column_numpy(tri, "split")
+    report(
+        "triplets.rooms",
+        tsplit != split,
+        "split",
+        lambda r: f"{tsplit[r]!r} in the {split} table; triplets never cross splits",
+    )
+    room = column_numpy(tri, "room_id")
+    rooms = set(raw["splits"].get(split, []))
+    out.count("triplets.rooms", n)
+    report(
+        "triplets.rooms",
+        ~np.isin(room, list(rooms)),
+        "room_id",
+        lambda r: f"{room[r]!r} is not a room of split {split}",
+    )
+
+    # --- references: every anchor / positive / negative is a row of this split
+    obs = tables.observations
+    obs_ids = obs.column("obs_id") if obs is not None else pa.array([], pa.string())
+    index = {}
+    out.count("triplets.references", 3 * n)
+    for role in ROLES:
+        idx = pc.index_in(tri.column(role), value_set=obs_ids)
+        index[role] = column_numpy(pa.table({"i": idx}), "i", -1).astype(np.int64)
+        values = column_numpy(tri, role)
+        report(
+            "triplets.references",
+            index[role] < 0,
+            role,
+            lambda r, v=values: f"{v[r]!r} is not an observation of split {split}",
+        )
+    found = np.all([index[r] >= 0 for r in ROLES], axis=0)
+
+    # --- no triplet across rooms
+    if obs is not None:
+        obs_room = column_numpy(obs, "room_id")
+        for role in ROLES:
+            ok = index[role] >= 0
+            other = np.where(ok, obs_room[np.maximum(index[role], 0)], None)
+            bad = ok & (other != room)
+            report(
+                "triplets.rooms",
+                bad,
+                role,
+                lambda r, o=other: f"a view of room {o[r]!r} in a triplet of room {room[r]!r}",
+            )
+
+    # --- composition: tier shares
+    tier = column_numpy(tri, "tier").astype(np.int64)
+    out.count("triplets.tiers", n)
+    report(
+        "triplets.tiers",
+        (tier < 0) | (tier >= len(TIERS)),
+        "tier",
+        lambda r: f"{tier[r]}; expected 0..{len(TIERS) - 1}",
+    )
+    counts = np.bincount(tier[(tier >= 0) & (tier < len(TIERS))], minlength=len(TIERS))
+    shares = _shares(raw)
+    if n >= 100:
+        bad_tiers = [k for k in range(len(TIERS)) if abs(counts[k] / n - shares[k]) > _POINT]
+        rule = "within ±1 point of"
+    else:
+        exact = tier_counts(n, shares)
+        bad_tiers = [k for k in range(len(TIERS)) if counts[k] != exact[k]]
+        rule = f"exactly tier_counts({n}) = {exact} for"
+    if bad_tiers:
+        have = ", ".join(f"{100 * c / max(n, 1):.1f}%" for c in counts)
+        want = ", ".join(f"{100 * s:.0f}%" for s in shares)
+        out.add(
+            "triplets.tiers",
+            file,
+            f"tiers {counts.tolist()} ({have}) of {n} triplets; expected {rule} the shares "
+            f"({want}); off in tier(s) {bad_tiers}",
+            field="tier",
+        )
+    listed = raw.get("counts", {}).get("tiers", {}).get(split)
+    if listed is not None and list(listed) != counts.tolist():
+        out.add(
+            "triplets.tiers",
+            MANIFEST,
+            f"counts.tiers.{split} = {list(listed)} but {file} holds {counts.tolist()}",
+            field=f"counts/tiers/{split}",
+        )
+
+    # --- offsets from the grid poses: tier rules and the stored offsets
+    if obs is None:
+        return
+    grid = {}
+    posed = found.copy()
+    for role in ROLES:
+        at = np.maximum(index[role], 0)
+        cols = []
+        for name in ("layout", "grid_i", "grid_j", "heading"):
+            col = obs.column(name)
+            valid = ~col.is_null().to_numpy(zero_copy_only=False)[at]
+            posed &= valid
+            cols.append(column_numpy(obs, name, 0).astype(np.int64)[at])
+        grid[role] = np.stack(cols, axis=1)
+    out.count("triplets.offsets", int(posed.sum()))
+    out.count("triplets.tier_rules", int(posed.sum()))
+    a = grid["anchor"]
+    for role in ("positive", "negative"):
+        g = grid[role]
+        step = (g[:, 3] - a[:, 3]) % 4
+        offset = np.stack([g[:, 1] - a[:, 1], g[:, 2] - a[:, 2], np.where(step == 3, -1, step)], 1)
+        stored, _ = fixed_numpy(tri.column(f"{role}_offset").combine_chunks(), 3, np.int64)
+        bad = posed & np.any(stored != offset, axis=1)
+        report(
+            "triplets.offsets",
+            bad,
+            f"{role}_offset",
+            lambda r, s=stored, o=offset: (
+                f"stored {s[r].tolist()}; the views' grid poses give {o[r].tolist()}"
+            ),
+        )
+        same_layout = g[:, 0] == a[:, 0]
+        dist = np.abs(offset[:, 0]) + np.abs(offset[:, 1])
+        for t in TIERS:
+            rule = getattr(t, role)
+            sel = posed & (tier == t.index)
+            wrong = sel & ((dist != rule.distance) | ((offset[:, 2] != 0) != rule.turn))
+            if rule.other_layout:
+                wrong |= sel & same_layout
+            report(
+                "triplets.tier_rules",
+                wrong,
+                role,
+                lambda r, o=offset, rule=rule, t=t, s=same_layout, role=role: (
+                    f"offset {o[r].tolist()}"
+                    f"{' in the same layout' if s[r] else ''}; tier {t.index} wants the {role} "
+                    f"{rule.describe()}"
+                ),
+            )
+
+
+def check_rooms_across_splits(splits: list[SplitTables], out: Collector) -> None:
+    """The observation rows of a room live in one split only."""
+    seen: dict[str, str] = {}
+    for tables in splits:
+        if tables.observations is None:
+            continue
+        for room in pc.unique(tables.observations.column("room_id")).to_pylist():
+            out.count("splits.disjoint")
+            if room in seen:
+                out.add(
+                    "splits.disjoint",
+                    f"observations/{tables.split}",
+                    f"room {room} has observations in splits {seen[room]} and {tables.split}",
+                    field="room_id",
+                )
+            else:
+                seen[room] = tables.split

@@ -1,0 +1,122 @@
+"""Relations recomputed from the stored 3D boxes and supports with
+:func:`sgdata.relations.compute_relations` (the manifest's rules) must equal the stored ones.
+
+The boxes are stored as float32 while the generator decided on float64 boxes, so a pair whose
+decision lies within :data:`BORDER` metres of a rule's boundary (a box face flush with another,
+two spheres just touching) can flip by rounding alone: such pairs are not compared.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..errors import ConfigError
+from ..relations import RelationRules, compute_relations
+from .loading import Flat, SplitTables, column_numpy
+from .report_types import Collector
+
+__all__ = ["BORDER", "borderline_pairs", "check_recompute"]
+
+BORDER = 1e-5  # metres: far above float32 rounding of room coordinates (< 1e-6 m), far below 1 mm
+
+
+def borderline_pairs(lo: np.ndarray, hi: np.ndarray, tol: float, eps: float = BORDER) -> np.ndarray:
+    """(n, n) bool: pairs whose in / proximity decision float32 rounding could flip."""
+    loose = strict = None
+    for k in range(3):
+        a = (lo[:, k, None] >= lo[None, :, k] - tol - eps) & (
+            hi[:, k, None] <= hi[None, :, k] + tol + eps
+        )
+        b = (lo[:, k, None] >= lo[None, :, k] - tol + eps) & (
+            hi[:, k, None] <= hi[None, :, k] + tol - eps
+        )
+        loose = a if loose is None else loose & a
+        strict = b if strict is None else strict & b
+    size = hi - lo
+    vol = size.prod(axis=1)
+    tie = np.abs(vol[:, None] - vol[None, :]) <= eps * (
+        1.0 + np.maximum(vol[:, None], vol[None, :])
+    )
+    border = (loose & ~strict) | (tie & loose)
+    centre = (lo + hi) / 2
+    radius = 0.5 * np.linalg.norm(size, axis=1)
+    dist = np.linalg.norm(centre[:, None, :] - centre[None, :, :], axis=2)
+    border |= np.abs(dist - (radius[:, None] + radius[None, :])) <= 4 * eps
+    return border | border.T
+
+
+def _rules(raw: dict[str, Any]) -> RelationRules:
+    r = raw.get("relation_rules", {})
+    return RelationRules(
+        box=str(r.get("box", "world_aabb")),
+        containment_tolerance=float(r.get("containment_tolerance", 0.0)),
+    )
+
+
+def check_recompute(
+    tables: SplitTables, raw: dict[str, Any], obj: Flat, rel: Flat, out: Collector
+) -> None:
+    """Compare stored relations with recomputed ones, synthetic rows with 3D boxes only."""
+    obs = tables.observations
+    if obs is None:
+        return
+    try:
+        rules = _rules(raw)
+    except ConfigError as exc:
+        out.add("relations.recompute", "dataset.json", str(exc), field="relation_rules")
+        return
+    names = raw["relation_types"]
+    name_of = lambda t: names[t] if 0 <= t < len(names) else str(t)  # noqa: E731
+    synthetic = column_numpy(obs, "domain") == "synthetic"
+    lo, lo_ok = obj.fixed("box3d_min", 3, np.float64)
+    hi, hi_ok = obj.fixed("box3d_max", 3, np.float64)
+    instance = obj.get("instance").astype(np.int64)
+    support = obj.get("support", -1).astype(np.int64)
+    src, dst = rel.get("src").astype(np.int64), rel.get("dst").astype(np.int64)
+    kind = rel.get("type").astype(np.int64)
+    n_rows = obs.num_rows
+    o_start = np.searchsorted(obj.parent, np.arange(n_rows + 1))
+    r_start = np.searchsorted(rel.parent, np.arange(n_rows + 1))
+    for row in np.flatnonzero(synthetic):
+        a, b = o_start[row], o_start[row + 1]
+        if not (lo_ok[a:b].all() and hi_ok[a:b].all()):
+            continue  # reported by objects.box3d
+        out.count("relations.recompute")
+        inst = instance[a:b]
+        got = compute_relations(inst, lo[a:b], hi[a:b], support[a:b], rules=rules)
+        c, d = r_start[row], r_start[row + 1]
+        stored = set(zip(src[c:d].tolist(), dst[c:d].tolist(), kind[c:d].tolist(), strict=True))
+        recomputed = set(zip(got.src.tolist(), got.dst.tolist(), got.type.tolist(), strict=True))
+        if stored == recomputed:
+            continue
+        order = np.argsort(inst, kind="stable")
+        border = borderline_pairs(lo[a:b][order], hi[a:b][order], rules.containment_tolerance)
+        ids = inst[order]
+        sup = dict(zip(inst.tolist(), support[a:b].tolist(), strict=True))
+
+        def pair_of(edge: tuple[int, int, int]) -> tuple[int, int]:
+            return (min(edge[0], edge[1]), max(edge[0], edge[1]))
+
+        diff: dict[tuple[int, int], tuple[list[str], list[str]]] = {}
+        for edges, side in ((stored - recomputed, 0), (recomputed - stored, 1)):
+            for edge in edges:
+                diff.setdefault(pair_of(edge), ([], []))[side].append(
+                    f"{name_of(edge[2])} {edge[0]}->{edge[1]}"
+                )
+        f, file_row = tables.where(row)
+        for (x, y), (was, now) in sorted(diff.items()):
+            i, j = np.searchsorted(ids, x), np.searchsorted(ids, y)
+            known = i < len(ids) and j < len(ids) and ids[i] == x and ids[j] == y
+            rests = sup.get(x) == y or sup.get(y) == x
+            if known and border[i, j] and not rests:
+                continue  # within float32 rounding of a rule boundary
+            out.add(
+                "relations.recompute",
+                tables.files[f],
+                f"pair ({x}, {y}): stored {', '.join(sorted(was)) or 'nothing'}; recomputed "
+                f"from the 3D boxes and supports: {', '.join(sorted(now)) or 'nothing'}",
+                row=file_row,
+                field="relations",
+            )

@@ -1,0 +1,293 @@
+"""sgdata.validate: a generated dataset is clean; each kind of damage is found and located."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from collections.abc import Callable
+from pathlib import Path
+
+import pyarrow as pa
+import pyarrow.parquet as pq
+import pytest
+
+from sgdata.config import load_config
+from sgdata.dataset import write_parquet
+from sgdata.errors import DatasetError
+from sgdata.generate import generate_dataset
+from sgdata.validate import ValidationReport, validate_dataset
+
+MINI = """
+[dataset]
+name = "mini-validate"
+seed = 3
+[rooms]
+types = ["bathroom"]
+train = 1
+val = 1
+test = 1
+[layouts]
+count = 2
+[camera]
+width = 96
+height = 96
+[triplets]
+train = 20
+val = 10
+test = 10
+"""
+SHARD = "observations/train/bathroom_000.parquet"
+TRIPLETS = "triplets/train.parquet"
+
+
+@pytest.fixture(scope="session")
+def mini_dataset(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    base = tmp_path_factory.mktemp("validate")
+    (base / "mini.toml").write_text(MINI)
+    root = base / "data"
+    generate_dataset(load_config(base / "mini.toml"), root, workers=2)
+    return root
+
+
+@pytest.fixture(scope="session")
+def clean_report(mini_dataset: Path) -> ValidationReport:
+    return validate_dataset(mini_dataset)
+
+
+@pytest.fixture
+def copy(mini_dataset: Path, tmp_path: Path) -> Path:
+    target = tmp_path / "copy"
+    shutil.copytree(mini_dataset, target)
+    return target
+
+
+# ------------------------------------------------------------------ damage helpers
+
+
+def edit_manifest(root: Path, change: Callable[[dict], None]) -> None:
+    raw = json.loads((root / "dataset.json").read_text())
+    change(raw)
+    (root / "dataset.json").write_text(json.dumps(raw, indent=2))
+
+
+def rewrite(root: Path, rel: str, table: pa.Table, *, update_manifest: bool = True) -> None:
+    """Write ``table`` over ``rel``; with ``update_manifest``, fix its rows/sha256/bytes."""
+    info = write_parquet(table, root / rel)
+
+    def fix(raw: dict) -> None:
+        for entry in raw["files"]:
+            if entry["path"] == rel:
+                entry.update(rows=info.rows, sha256=info.sha256, bytes=info.bytes)
+
+    if update_manifest:
+        edit_manifest(root, fix)
+
+
+def rows_of(root: Path, rel: str) -> tuple[list[dict], pa.Schema]:
+    table = pq.read_table(root / rel)
+    return table.to_pylist(), table.schema
+
+
+def checks(report: ValidationReport) -> set[str]:
+    return {p.check for p in report.problems}
+
+
+def find(report: ValidationReport, check: str) -> list:
+    found = [p for p in report.problems if p.check == check]
+    assert found, f"{check} not reported; got {sorted(checks(report))}"
+    return found
+
+
+# ------------------------------------------------------------------ tests
+
+
+def test_generated_dataset_is_clean(clean_report: ValidationReport) -> None:
+    assert clean_report.ok, [(p.check, p.location(), p.message) for p in clean_report.problems]
+    assert clean_report.checked["relations.recompute"] > 0
+    assert clean_report.checked["images.decode"] > 0
+    assert clean_report.checked["triplets.offsets"] == 40
+    data = json.loads(clean_report.to_json())
+    assert data["ok"] is True and data["problems"] == []
+
+
+def test_quick_skips_images(mini_dataset: Path) -> None:
+    report = validate_dataset(mini_dataset, quick=True)
+    assert report.ok and "images.decode" in report.skipped
+    assert "images.decode" not in report.checked
+
+
+def test_not_a_dataset(tmp_path: Path) -> None:
+    with pytest.raises(DatasetError, match="no dataset.json"):
+        validate_dataset(tmp_path)
+    with pytest.raises(DatasetError, match="no such directory"):
+        validate_dataset(tmp_path / "nothing")
+
+
+def test_truncated_shard(copy: Path) -> None:
+    table = pq.read_table(copy / SHARD)
+    rewrite(copy, SHARD, table.slice(0, table.num_rows - 3), update_manifest=False)
+    report = validate_dataset(copy, quick=True)
+    assert not report.ok
+    (rows,) = find(report, "files.rows")
+    assert rows.file == SHARD and f"{table.num_rows - 3} rows" in rows.message
+    assert find(report, "files.sha256")[0].file == SHARD
+
+
+def test_changed_bytes_change_sha(copy: Path) -> None:
+    scene = copy / "scenes/bathroom_000/layout_1.usda"
+    text = scene.read_bytes()
+    at = text.index(b"(", text.index(b"xformOp:translate ="))
+    digit = next(k for k in range(at, len(text)) if text[k : k + 1].isdigit())
+    flipped = b"1" if text[digit : digit + 1] != b"1" else b"2"
+    scene.write_bytes(text[:digit] + flipped + text[digit + 1 :])
+    report = validate_dataset(copy, quick=True)
+    assert checks(report) == {"files.sha256"}
+    assert report.problems[0].file == "scenes/bathroom_000/layout_1.usda"
+
+
+def test_changed_column_type(copy: Path) -> None:
+    table = pq.read_table(copy / SHARD)
+    at = table.schema.get_field_index("layout")
+    layout = pa.field("layout", pa.int64(), nullable=False)
+    rewrite(copy, SHARD, table.set_column(at, layout, table.column("layout").cast(pa.int64())))
+    report = validate_dataset(copy, quick=True)
+    (problem,) = find(report, "tables.schema")
+    assert (problem.file, problem.field) == (SHARD, "layout")
+    assert "int64" in problem.message and "int16" in problem.message
+    assert checks(report) == {"tables.schema"}  # the rows were still checked, and are fine
+
+
+def test_dropped_column(copy: Path) -> None:
+    table = pq.read_table(copy / SHARD)
+    rewrite(copy, SHARD, table.drop_columns(["seed"]))
+    report = validate_dataset(copy, quick=True)
+    problems = find(report, "tables.schema")
+    assert any(p.field == "seed" and "missing" in p.message for p in problems)
+
+
+def test_dangling_triplet_id(copy: Path) -> None:
+    rows, schema = rows_of(copy, TRIPLETS)
+    rows[4]["negative"] = "bathroom_000/1/99/99/0"
+    rewrite(copy, TRIPLETS, pa.Table.from_pylist(rows, schema=schema))
+    report = validate_dataset(copy, quick=True)
+    (problem,) = find(report, "triplets.references")
+    assert (problem.file, problem.row, problem.field) == (TRIPLETS, 4, "negative")
+    assert checks(report) == {"triplets.references"}
+
+
+def _first(rows: list[dict], pick: Callable[[dict], bool]) -> int:
+    return next(k for k, r in enumerate(rows) if pick(r))
+
+
+def test_box2d_outside_image(copy: Path) -> None:
+    rows, schema = rows_of(copy, SHARD)
+    k = _first(rows, lambda r: len(r["objects"]) > 1)
+    box = rows[k]["objects"][1]["box2d"]
+    rows[k]["objects"][1]["box2d"] = [box[0], box[1], 96 + 7, box[3]]
+    rewrite(copy, SHARD, pa.Table.from_pylist(rows, schema=schema))
+    report = validate_dataset(copy, quick=True)
+    (problem,) = find(report, "objects.box2d")
+    assert (problem.file, problem.row, problem.field) == (SHARD, k, "objects[1].box2d")
+    assert "103" in problem.message
+    assert checks(report) == {"objects.box2d"}
+
+
+def test_one_way_proximity(copy: Path) -> None:
+    rows, schema = rows_of(copy, SHARD)
+    k = _first(rows, lambda r: any(e["type"] == 2 for e in r["relations"]))
+    edges = rows[k]["relations"]
+    drop = next(e for e in edges if e["type"] == 2)
+    rows[k]["relations"] = [e for e in edges if e is not drop]
+    rewrite(copy, SHARD, pa.Table.from_pylist(rows, schema=schema))
+    report = validate_dataset(copy, quick=True)
+    (problem,) = find(report, "relations.symmetric")
+    assert (problem.file, problem.row) == (SHARD, k)
+    assert f"{drop['dst']}->{drop['src']}" in problem.message
+    assert checks(report) <= {"relations.symmetric", "relations.recompute"}
+
+
+def _view_with_on(root: Path) -> tuple[str, list[dict], pa.Schema, int, dict]:
+    for rel in sorted(p.relative_to(root).as_posix() for p in root.glob("observations/*/*")):
+        rows, schema = rows_of(root, rel)
+        for k, r in enumerate(rows):
+            on = [e for e in r["relations"] if e["type"] == 0]
+            if on:
+                return rel, rows, schema, k, on[0]
+    pytest.skip("no view with an 'on' relation in the mini dataset")
+
+
+def test_on_and_in_for_one_pair(copy: Path) -> None:
+    rel, rows, schema, k, on = _view_with_on(copy)
+    edges = rows[k]["relations"] + [{"src": on["dst"], "dst": on["src"], "type": 1}]
+    rows[k]["relations"] = sorted(edges, key=lambda e: (e["src"], e["dst"]))
+    rewrite(copy, rel, pa.Table.from_pylist(rows, schema=schema))
+    report = validate_dataset(copy, quick=True)
+    (problem,) = find(report, "relations.on_and_in")
+    assert (problem.file, problem.row) == (rel, k)
+    assert problem.field.startswith("relations[") and problem.field.endswith("].type")
+
+
+def test_relations_recompute_mismatch(copy: Path) -> None:
+    rows, schema = rows_of(copy, SHARD)
+    k = _first(rows, lambda r: any(e["type"] == 2 for e in r["relations"]))
+    first = next(e for e in rows[k]["relations"] if e["type"] == 2)
+    pair = {first["src"], first["dst"]}
+    for e in rows[k]["relations"]:
+        if {e["src"], e["dst"]} == pair:
+            e["type"] = 3  # proximity -> disjoint, both directions: still well-formed
+    rewrite(copy, SHARD, pa.Table.from_pylist(rows, schema=schema))
+    report = validate_dataset(copy, quick=True)
+    assert checks(report) == {"relations.recompute"}
+    (problem,) = report.problems
+    assert (problem.file, problem.row, problem.field) == (SHARD, k, "relations")
+    assert "stored disjoint" in problem.message and "recomputed" in problem.message
+
+
+def test_skewed_composition(copy: Path) -> None:
+    rows, schema = rows_of(copy, TRIPLETS)
+    for r in rows:
+        if r["tier"] == 0:
+            r["tier"] = 1
+            break
+    rewrite(copy, TRIPLETS, pa.Table.from_pylist(rows, schema=schema))
+    report = validate_dataset(copy, quick=True)
+    problems = find(report, "triplets.tiers")
+    assert any(p.file == TRIPLETS and p.field == "tier" for p in problems)
+    assert any(p.file == "dataset.json" for p in problems)  # counts.tiers no longer match
+    assert "triplets.tier_rules" in checks(report)  # a tier-0 triplet cannot pass as tier 1
+
+
+def test_room_in_two_splits(copy: Path) -> None:
+    edit_manifest(copy, lambda raw: raw["splits"]["val"].append("bathroom_000"))
+    report = validate_dataset(copy, quick=True)
+    (problem,) = find(report, "splits.disjoint")
+    assert "bathroom_000" in problem.message and problem.file == "dataset.json"
+    assert problem.field == "splits/val"
+
+
+def test_corrupt_image(copy: Path) -> None:
+    table = pq.read_table(copy / SHARD)
+    images = table.column("image").to_pylist()
+    images[2] = b"\x89PNG garbage" + bytes(200)
+    at = table.schema.get_field_index("image")
+    table = table.set_column(at, table.schema.field("image"), pa.array(images, pa.binary()))
+    rewrite(copy, SHARD, table)
+    report = validate_dataset(copy)
+    assert checks(report) == {"images.decode"}
+    (problem,) = report.problems
+    assert (problem.file, problem.row, problem.field) == (SHARD, 2, "image")
+
+
+def test_unlisted_shard(copy: Path) -> None:
+    shutil.copy(copy / SHARD, copy / "observations/train/bathroom_999.parquet")
+    report = validate_dataset(copy, quick=True)
+    assert checks(report) == {"files.unlisted"}
+
+
+def test_manifest_schema_and_version(copy: Path) -> None:
+    edit_manifest(copy, lambda raw: raw.update(num_slots="many", format_version="1.0.0"))
+    report = validate_dataset(copy, quick=True)
+    assert find(report, "manifest.schema")[0].field == "num_slots"
+    edit_manifest(copy, lambda raw: raw.update(format_version="2.0.0"))
+    report = validate_dataset(copy, quick=True)
+    assert "newer" in find(report, "manifest.version")[0].message
