@@ -1,13 +1,15 @@
 """Triplets per second: the SeanNet DataLoader against raw Parquet read + PNG decode.
 
     python bench/loader.py                  # generates the `tiny` preset into a temp dir
-    python bench/loader.py --data out/tiny --size 112 --epochs 3
+    python bench/loader.py --data out/tiny --size 112 --epochs 3 --threads 1
 
 The lower bound reads the image column of every observation shard of the split once and
 decodes the three images of every triplet (no resize, normalisation or graph tensors). The
 loader runs `DataLoader(TripletDataset, batch_size=8, collate_fn=collate_triplets)` with 0 and
 2 workers (persistent, so epochs after the first reuse the workers' shard caches); it prints
 the first (cold) epoch and the mean of the later (warm) ones, each as a ratio to the bound.
+``--threads`` sets the main process's torch threads (workers always use 1): on a small or
+busy machine, torch's intra-op pool can make collation (torch.stack) tens of times slower.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ import time
 from pathlib import Path
 
 import pyarrow.parquet as pq
+import torch
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
@@ -82,7 +85,9 @@ def main() -> None:
     parser.add_argument("--size", type=int, default=224, help="ImageTransform size")
     parser.add_argument("--epochs", type=int, default=3)
     parser.add_argument("--batch-size", type=int, default=8)
+    parser.add_argument("--threads", type=int, default=1, help="main-process torch threads")
     args = parser.parse_args()
+    torch.set_num_threads(args.threads)
 
     tmp = None
     root = args.data
@@ -95,7 +100,8 @@ def main() -> None:
     print(
         f"dataset {ds.manifest.name} {args.split}: {n} triplets, "
         f"{ds.manifest.image.width}x{ds.manifest.image.height} {ds.manifest.image.format}; "
-        f"resize to {args.size}, batch {args.batch_size}, {args.epochs} epochs"
+        f"resize to {args.size}, batch {args.batch_size}, {args.epochs} epochs, "
+        f"{args.threads} torch thread(s)"
     )
 
     raw_epoch(root, args.split)  # warm the page cache

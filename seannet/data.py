@@ -152,10 +152,14 @@ class ImageTransform:
         s = self.size
         if (h, w) != (s, s):
             rgb = np.asarray(Image.fromarray(rgb).resize((s, s), Image.Resampling.BILINEAR))
-        x = rgb.astype(np.float32) * np.float32(1 / 255)
-        x -= np.asarray(self.mean, dtype=np.float32)
-        x /= np.asarray(self.std, dtype=np.float32)
-        image = torch.from_numpy(np.ascontiguousarray(x.transpose(2, 0, 1)))
+        # (x / 255 - mean) / std as one multiply-add, on the CHW copy of the uint8 pixels
+        std = np.asarray(self.std, dtype=np.float64)
+        scale = (1.0 / (255.0 * std)).astype(np.float32)[:, None, None]
+        offset = (-np.asarray(self.mean, dtype=np.float64) / std).astype(np.float32)[:, None, None]
+        x = np.ascontiguousarray(rgb.transpose(2, 0, 1)).astype(np.float32)
+        x *= scale
+        x += offset
+        image = torch.from_numpy(x)
         scale = np.asarray([s / w, s / h, s / w, s / h], dtype=np.float32)
         return image, torch.from_numpy(np.asarray(boxes, dtype=np.float32).reshape(-1, 4) * scale)
 

@@ -30,6 +30,7 @@ from .model import build_model
 __all__ = ["EpochResult", "train", "build_for_dataset", "device_for_run"]
 
 LAST, BEST, HISTORY = "last.pt", "best.pt", "history.json"
+INIT_KEY = 1 << 20  # seed path of the initial weights (epochs use 0, 1, 2, ...)
 
 
 @dataclass(frozen=True)
@@ -88,6 +89,7 @@ def train(
     train_set = TripletDataset(data, "train", transform=transform)
     val_set = TripletDataset(data, "val", transform=transform)
     device = device_for_run()
+    torch.manual_seed(derive_seed(config.seed, INIT_KEY))  # the initial weights
     model = build_for_dataset(config, data, pretrained=pretrained).to(device)
     optimizer = torch.optim.SGD(model.parameters(), lr=config.lr, momentum=config.momentum)
     schedule = torch.optim.lr_scheduler.StepLR(optimizer, config.decay_every, config.lr_decay)
@@ -98,7 +100,9 @@ def train(
     if resume:
         state = load_checkpoint(last)
         check_same_dataset(last, state["dataset"], identity)
-        if state["config"] != config.to_dict():
+        # a resumed run may be given more epochs; everything else must match
+        saved = {**state["config"], "epochs": config.epochs}
+        if saved != config.to_dict():
             raise CheckpointError(f"{last}: was trained with another config; resume with that one")
         model.load_state_dict(state["model"])
         optimizer.load_state_dict(state["optimizer"])
@@ -172,7 +176,7 @@ def _train_epoch(
         optimizer.step()
         with torch.no_grad():
             correct += float((similarity(a, p) > similarity(a, n)).sum())
-        total_loss += float(loss) * len(a)
+        total_loss += float(loss.detach()) * len(a)
         seen += len(a)
         if progress is not None:
             progress("train", step, len(loader), {"loss": total_loss / seen, "acc": correct / seen})

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -168,3 +169,46 @@ def tiny_renderer(renderer: object, tiny_room: TinyRoom) -> object:
 def tiny_view() -> tuple[float, float, float]:
     """(x, y, theta) from which every interesting object of the tiny room is in view."""
     return TINY_VIEW
+
+
+# One small real dataset for every test that reads one: three bathrooms (train, val, test),
+# two layouts each, 96 px views, 20 / 10 / 10 triplets. About 20 s to generate, once.
+MINI_TOML = """\
+[dataset]
+name = "mini"
+version = "0.0.1"
+seed = 5
+[rooms]
+types = ["bathroom"]
+train = 1
+val = 1
+test = 1
+[layouts]
+count = 2
+[camera]
+width = 96
+height = 96
+[triplets]
+train = 20
+val = 10
+test = 10
+"""
+MINI_TRIPLETS = {"train": 20, "val": 10, "test": 10}
+
+
+@pytest.fixture(scope="session")
+def mini_config_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    path = tmp_path_factory.mktemp("mini_config") / "mini.toml"
+    path.write_text(MINI_TOML)
+    return path
+
+
+@pytest.fixture(scope="session")
+def mini_dataset(tmp_path_factory: pytest.TempPathFactory, mini_config_file: Path) -> Path:
+    """Root of the generated mini dataset (real USD, Parquet and PNG)."""
+    from sgdata.config import load_config
+    from sgdata.generate import generate_dataset
+
+    root = tmp_path_factory.mktemp("mini_dataset") / "data"
+    generate_dataset(load_config(mini_config_file), root, workers=2)
+    return root

@@ -14,33 +14,13 @@ import duckdb
 import polars as pl
 import pyarrow.parquet as pq
 import pytest
+from conftest import MINI_TRIPLETS
 
 from sgdata.config import load_config
 from sgdata.dataset import Dataset
 from sgdata.errors import ConfigError, DatasetError
 from sgdata.generate import LEDGER, generate_dataset
 from sgdata.triplets import tier_counts
-
-# Two bathrooms (train, test), two layouts, 96 px views: a real run in seconds.
-MINI = """
-[dataset]
-name = "mini"
-seed = 5
-[rooms]
-types = ["bathroom"]
-train = 1
-val = 0
-test = 1
-[layouts]
-count = 2
-[camera]
-width = 96
-height = 96
-[triplets]
-train = 12
-val = 0
-test = 8
-"""
 
 
 def digest_tree(root: Path) -> dict[str, str]:
@@ -50,20 +30,6 @@ def digest_tree(root: Path) -> dict[str, str]:
         for p in sorted(root.rglob("*"))
         if p.is_file() and LEDGER not in p.parts
     }
-
-
-@pytest.fixture(scope="module")
-def mini_config_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    path = tmp_path_factory.mktemp("cfg") / "mini.toml"
-    path.write_text(MINI)
-    return path
-
-
-@pytest.fixture(scope="module")
-def mini_dataset(tmp_path_factory: pytest.TempPathFactory, mini_config_file: Path) -> Path:
-    root = tmp_path_factory.mktemp("data") / "mini"
-    generate_dataset(load_config(mini_config_file), root, workers=1)
-    return root
 
 
 def test_worker_count_does_not_change_bytes(
@@ -76,7 +42,7 @@ def test_worker_count_does_not_change_bytes(
 
 def test_composition_and_offsets(mini_dataset: Path) -> None:
     dataset = Dataset.open(mini_dataset)
-    for split, total in (("train", 12), ("test", 8)):
+    for split, total in MINI_TRIPLETS.items():
         triplets = dataset.triplets(split).to_pylist()
         tiers = [sum(t["tier"] == k for t in triplets) for k in range(5)]
         assert tiers == tier_counts(total)
@@ -107,7 +73,7 @@ def test_standard_tools_read_it(mini_dataset: Path) -> None:
     tiers = duckdb.sql(
         f"SELECT tier, count(*) FROM '{mini_dataset / 'triplets' / 'train.parquet'}' GROUP BY tier"
     ).fetchall()
-    assert sum(n for _, n in tiers) == 12
+    assert sum(n for _, n in tiers) == MINI_TRIPLETS["train"]
 
 
 def test_refuses_to_overwrite(mini_dataset: Path, mini_config_file: Path, tmp_path: Path) -> None:

@@ -11,43 +11,12 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
-from sgdata.config import load_config
 from sgdata.dataset import write_parquet
 from sgdata.errors import DatasetError
-from sgdata.generate import generate_dataset
 from sgdata.validate import ValidationReport, validate_dataset
 
-MINI = """
-[dataset]
-name = "mini-validate"
-seed = 3
-[rooms]
-types = ["bathroom"]
-train = 1
-val = 1
-test = 1
-[layouts]
-count = 2
-[camera]
-width = 96
-height = 96
-[triplets]
-train = 20
-val = 10
-test = 10
-"""
-SHARD = "observations/train/bathroom_000.parquet"
+SHARD = "observations/train/bathroom_000.parquet"  # the mini dataset's train room
 TRIPLETS = "triplets/train.parquet"
-
-
-@pytest.fixture(scope="session")
-def mini_dataset(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    base = tmp_path_factory.mktemp("validate")
-    (base / "mini.toml").write_text(MINI)
-    root = base / "data"
-    generate_dataset(load_config(base / "mini.toml"), root, workers=2)
-    return root
-
 
 @pytest.fixture(scope="session")
 def clean_report(mini_dataset: Path) -> ValidationReport:
