@@ -197,6 +197,12 @@ MINI_TRIPLETS = {"train": 20, "val": 10, "test": 10}
 
 
 @pytest.fixture(scope="session")
+def mini_triplets() -> dict[str, int]:
+    """Triplets per split of the mini dataset."""
+    return dict(MINI_TRIPLETS)
+
+
+@pytest.fixture(scope="session")
 def mini_config_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
     path = tmp_path_factory.mktemp("mini_config") / "mini.toml"
     path.write_text(MINI_TOML)

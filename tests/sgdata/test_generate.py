@@ -14,7 +14,6 @@ import duckdb
 import polars as pl
 import pyarrow.parquet as pq
 import pytest
-from conftest import MINI_TRIPLETS
 
 from sgdata.config import load_config
 from sgdata.dataset import Dataset
@@ -40,9 +39,9 @@ def test_worker_count_does_not_change_bytes(
     assert digest_tree(other) == digest_tree(mini_dataset)
 
 
-def test_composition_and_offsets(mini_dataset: Path) -> None:
+def test_composition_and_offsets(mini_triplets: dict[str, int], mini_dataset: Path) -> None:
     dataset = Dataset.open(mini_dataset)
-    for split, total in MINI_TRIPLETS.items():
+    for split, total in mini_triplets.items():
         triplets = dataset.triplets(split).to_pylist()
         tiers = [sum(t["tier"] == k for t in triplets) for k in range(5)]
         assert tiers == tier_counts(total)
@@ -60,7 +59,7 @@ def test_composition_and_offsets(mini_dataset: Path) -> None:
                 assert p["layout"] != a["layout"]
 
 
-def test_standard_tools_read_it(mini_dataset: Path) -> None:
+def test_standard_tools_read_it(mini_triplets: dict[str, int], mini_dataset: Path) -> None:
     shard = next((mini_dataset / "observations" / "train").glob("*.parquet"))
     table = pq.read_table(shard)
     assert table.num_rows > 0
@@ -73,7 +72,7 @@ def test_standard_tools_read_it(mini_dataset: Path) -> None:
     tiers = duckdb.sql(
         f"SELECT tier, count(*) FROM '{mini_dataset / 'triplets' / 'train.parquet'}' GROUP BY tier"
     ).fetchall()
-    assert sum(n for _, n in tiers) == MINI_TRIPLETS["train"]
+    assert sum(n for _, n in tiers) == mini_triplets["train"]
 
 
 def test_refuses_to_overwrite(mini_dataset: Path, mini_config_file: Path, tmp_path: Path) -> None:

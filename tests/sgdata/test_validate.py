@@ -18,6 +18,7 @@ from sgdata.validate import ValidationReport, validate_dataset
 SHARD = "observations/train/bathroom_000.parquet"  # the mini dataset's train room
 TRIPLETS = "triplets/train.parquet"
 
+
 @pytest.fixture(scope="session")
 def clean_report(mini_dataset: Path) -> ValidationReport:
     return validate_dataset(mini_dataset)
