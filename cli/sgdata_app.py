@@ -32,12 +32,19 @@ def rooms(
     count: Annotated[int, typer.Option(help="How many rooms.")] = 1,
     seed: Annotated[int, typer.Option(help="Dataset seed; each room derives its own.")] = 0,
     first_index: Annotated[int, typer.Option(help="Index of the first room.")] = 0,
+    catalog: Annotated[
+        Path | None, typer.Option(help="An object catalog TOML (default: the shipped one).")
+    ] = None,
 ) -> None:
     """Generate procedural rooms and write them as USD stages."""
+    from sgdata.catalog import load_catalog
     from sgdata.rooms import room_stats
     from sgdata.scenes import write_rooms
 
-    made = write_rooms(out, room_type, count=count, seed=seed, first_index=first_index)
+    classes = load_catalog(catalog)
+    made = write_rooms(
+        out, room_type, count=count, seed=seed, first_index=first_index, catalog=classes
+    )
     table = Table(title=f"{len(made)} {room_type} room(s) in {out}")
     for column in ("room", "size (m)", "objects", "static", "low", "high", "classes"):
         table.add_column(column, justify="left" if column == "room" else "right")

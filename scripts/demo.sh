@@ -6,6 +6,7 @@ cd "$(dirname "$0")/.."
 out=${1:-out/demo}
 sgdata=.venv/bin/sgdata
 $sgdata generate tiny "$out" --force
+$sgdata validate "$out"
 room="$out/scenes/kitchen_000"
 $sgdata preview "$room/layout_1.usda" --compare -o "$out/previews/kitchen_000_layout_1.png"
 $sgdata render "$room" --layout 1 -o "$out/previews/kitchen_000_view.png"

@@ -7,6 +7,7 @@ Importing sgdata starts no renderer and changes no environment variable.
 
 from .catalog import Catalog, ClassSpec, load_catalog
 from .config import GenerateConfig, load_config
+from .dataset import Dataset
 from .dynamics import DynamicsConfig, Layout, sample_layouts, summarize_layouts
 from .errors import (
     CatalogError,
@@ -17,6 +18,7 @@ from .errors import (
     SgdataError,
     UsdError,
 )
+from .generate import generate_dataset
 from .poses import PoseGrid, pose_grid
 from .relations import RelationRules, RelationType, compute_relations
 from .render import CameraConfig, Renderer
@@ -25,6 +27,7 @@ from .scene import Dynamics, Opening, Placement, Room, SceneObject
 from .scenes import load_layout, write_layouts, write_rooms
 from .slots import SlotTable
 from .triplets import Triplet, sample_triplets
+from .validate import validate_dataset
 from .views import ViewAnnotator, ViewRecord
 
 __version__ = "0.1.0"
@@ -35,6 +38,7 @@ __all__ = [
     "CatalogError",
     "ClassSpec",
     "ConfigError",
+    "Dataset",
     "DatasetError",
     "Dynamics",
     "DynamicsConfig",
@@ -57,6 +61,7 @@ __all__ = [
     "ViewAnnotator",
     "ViewRecord",
     "compute_relations",
+    "generate_dataset",
     "generate_room",
     "load_catalog",
     "load_config",
@@ -65,6 +70,7 @@ __all__ = [
     "sample_layouts",
     "sample_triplets",
     "summarize_layouts",
+    "validate_dataset",
     "write_layouts",
     "write_rooms",
 ]

@@ -63,6 +63,34 @@ def test_bad_input_is_one_line_exit_2(tmp_path: Path, args: tuple[str, ...], nee
     assert not (tmp_path / "x").exists()
 
 
+def test_malformed_catalog(tmp_path: Path) -> None:
+    catalog = tmp_path / "catalog.toml"
+    shipped = (Path(__file__).parents[2] / "assets" / "catalog.toml").read_text()
+    catalog.write_text(shipped.replace('dynamics = "high"', 'dynamics = "fast"', 1))
+    result = run("rooms", str(tmp_path / "x"), "--catalog", str(catalog))
+    assert_one_line_error(result, "field 'dynamics' is 'fast'")
+    catalog.write_text("[classes.Mug\n")
+    assert_one_line_error(
+        run("rooms", str(tmp_path / "x"), "--catalog", str(catalog)), "not valid TOML"
+    )
+    assert not (tmp_path / "x").exists()
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (("generate", "huge", "{tmp}/d"), "expected one of tiny, small, paper"),
+        (("generate", "{tmp}/bad.toml", "{tmp}/d"), "unknown key 'roomz'"),
+        (("generate", "tiny", "{tmp}/a_file"), "is a file"),
+    ],
+)
+def test_generate_bad_input(tmp_path: Path, args: tuple[str, ...], needle: str) -> None:
+    (tmp_path / "bad.toml").write_text("[roomz]\n")
+    (tmp_path / "a_file").write_text("x")
+    assert_one_line_error(run(*(a.format(tmp=tmp_path) for a in args)), needle)
+    assert not (tmp_path / "d").exists()
+
+
 def test_unwritable_output(tmp_path: Path) -> None:
     if os.geteuid() == 0:
         target = Path("/proc/sgdata-out")  # root ignores permission bits; /proc refuses mkdir

@@ -17,7 +17,7 @@ from sgdata.rooms import generate_room
 from sgdata.scene import Room, SceneObject
 from sgdata.scenes import write_rooms
 from sgdata.shapes import build_shape
-from sgdata.usd_io import read_room
+from sgdata.usd_io import read_room, validate_stage
 from sgdata.validity import room_problems
 
 
@@ -148,6 +148,12 @@ def test_usd_round_trip(tmp_path: Path, catalog: Catalog) -> None:
         )
         assert np.allclose(a.placement.matrix(), b.placement.matrix(), atol=1e-6)
         assert np.allclose(a.size, b.size, atol=1e-6)
+
+
+def test_generated_stages_pass_usd_validators(tmp_path: Path, catalog: Catalog) -> None:
+    for room_type in ROOM_TYPES:
+        (room,) = write_rooms(tmp_path, room_type, count=1, seed=2, catalog=catalog)
+        assert validate_stage(tmp_path / room.room_id / "room.usda") == []
 
 
 def test_bad_arguments_raise_config_errors(tmp_path: Path, catalog: Catalog) -> None:
