@@ -40,6 +40,9 @@ def train(
         Path | None,
         typer.Option(help="Local ImageNet weights (torchvision state_dict), sha256-checked."),
     ] = None,
+    pretrained_sha256: Annotated[
+        str | None, typer.Option(help="Expected SHA-256 of --pretrained (default: known hashes).")
+    ] = None,
     seed: Annotated[int, typer.Option(help="Seed of batch order and dropout.")] = 0,
 ) -> None:
     """Train a model with the triplet loss; validates every epoch, keeps the best checkpoint."""

@@ -20,7 +20,9 @@ from .evaluate import (
     MAX_OFFSET,
     choose_threshold,
     embed_split,
+    example_groups,
     offset_statistics,
+    similarity_of,
     threshold_quality,
     triplet_metrics,
 )
@@ -47,7 +49,8 @@ def evaluate_run(run: Path, data: Path, *, split: str = "test", out: Path | None
     val = embed_split(model, config, data, "val", device)
     evaluated = embed_split(model, config, data, split, device)
     transform = ImageTransform(size=config.image_size)
-    metrics = triplet_metrics(evaluated, TripletDataset(data, split, transform=transform))
+    triplets = TripletDataset(data, split, transform=transform)
+    metrics = triplet_metrics(evaluated, triplets)
     threshold = choose_threshold(val)
     quality = threshold_quality(evaluated, threshold["epsilon"])
     stats = offset_statistics(evaluated)
@@ -64,6 +67,7 @@ def evaluate_run(run: Path, data: Path, *, split: str = "test", out: Path | None
         "offset_count": stats["count"].astype(int).tolist(),
     }
     out.mkdir(parents=True, exist_ok=True)
+    result["examples"] = _examples(evaluated, triplets, out, split, config.model)
     atomic_write_text(out / f"eval_{split}.json", json.dumps(result, indent=2))
     atomic_write_text(out / f"eval_{split}.md", _markdown(result))
     save_png(
@@ -103,46 +107,66 @@ def _markdown(result: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def draw_heatmap(grid: np.ndarray, title: str, *, cell: int = 44) -> Image.Image:
-    """A (2k+1)^2 grid of values as coloured cells with numbers; rows delta i, columns delta j."""
-    size = grid.shape[0]
+def draw_heatmap(grid: np.ndarray, title: str) -> Image.Image:
+    """Similarity by grid offset: rows delta i, columns delta j, both -4 .. +4."""
+    labels = [f"{k - MAX_OFFSET:+d}" for k in range(grid.shape[0])]
+    return draw_matrix(grid, labels, labels, title)
+
+
+def draw_matrix(
+    grid: np.ndarray, rows: list[str], columns: list[str], title: str, *, cell: int = 44
+) -> Image.Image:
+    """A matrix of values as coloured, numbered cells (NaN cells grey), with labels."""
     margin = 40
-    image = Image.new("RGB", (margin + size * cell + 10, margin + size * cell + 24), "white")
+    height, width = grid.shape
+    image = Image.new("RGB", (margin + width * cell + 10, margin + height * cell + 24), "white")
     draw = ImageDraw.Draw(image)
     font = ImageFont.load_default(size=11)
-    draw.text((margin, 4), title, fill="black", font=font)
+    draw.text((4, 4), title, fill="black", font=font)
     finite = grid[np.isfinite(grid)]
     lo, hi = (float(finite.min()), float(finite.max())) if len(finite) else (0.0, 1.0)
-    for r in range(size):
-        for c in range(size):
-            x, y = margin + c * cell, 20 + margin + r * cell - 20
+    for r in range(height):
+        y = margin + r * cell
+        draw.text((margin - 6, y + cell / 2), rows[r], fill="black", font=font, anchor="rm")
+        for c in range(width):
+            x = margin + c * cell
             value = grid[r, c]
-            if math.isfinite(value):
-                t = (value - lo) / (hi - lo) if hi > lo else 1.0
-                color = (int(255 * t), int(80 + 100 * (1 - abs(2 * t - 1))), int(255 * (1 - t)))
-                draw.rectangle([x, y, x + cell - 1, y + cell - 1], fill=color)
-                draw.text(
-                    (x + cell / 2, y + cell / 2),
-                    f"{value:.2f}",
-                    fill="white",
-                    font=font,
-                    anchor="mm",
-                )
-            else:
+            if not math.isfinite(value):
                 draw.rectangle([x, y, x + cell - 1, y + cell - 1], fill=(235, 235, 235))
+                continue
+            t = (value - lo) / (hi - lo) if hi > lo else 1.0
+            color = (int(255 * t), int(80 + 100 * (1 - abs(2 * t - 1))), int(255 * (1 - t)))
+            draw.rectangle([x, y, x + cell - 1, y + cell - 1], fill=color)
+            draw.text(
+                (x + cell / 2, y + cell / 2), f"{value:.3f}", fill="white", font=font, anchor="mm"
+            )
+    for c in range(width):
         draw.text(
-            (margin - 6, 20 + margin + r * cell - 20 + cell / 2),
-            f"{r - MAX_OFFSET:+d}",
-            fill="black",
-            font=font,
-            anchor="rm",
-        )
-    for c in range(size):
-        draw.text(
-            (margin + c * cell + cell / 2, margin + size * cell + 8),
-            f"{c - MAX_OFFSET:+d}",
+            (margin + c * cell + cell / 2, margin + height * cell + 8),
+            columns[c],
             fill="black",
             font=font,
             anchor="mm",
         )
     return image
+
+
+def _examples(evaluated, triplets: TripletDataset, out: Path, split: str, model: str) -> list:  # noqa: ANN001
+    """Pairwise similarity of a few tier-0 triplets with their extra positives (paper Fig. 7)."""
+    examples = []
+    pictures = []
+    for group in example_groups(evaluated, triplets):
+        labels = ["A", *(f"P{k}" for k in range(1, len(group) - 1)), "N"]
+        matrix = similarity_of(evaluated, group)
+        examples.append({"ids": group, "labels": labels, "similarity": matrix.round(4).tolist()})
+        pictures.append(draw_matrix(matrix, labels, labels, f"{model}: {group[0]}"))
+    if pictures:
+        sheet = Image.new(
+            "RGB", (sum(p.width for p in pictures), max(p.height for p in pictures)), "white"
+        )
+        x = 0
+        for picture in pictures:
+            sheet.paste(picture, (x, 0))
+            x += picture.width
+        save_png(sheet, out / f"examples_{split}.png")
+    return examples

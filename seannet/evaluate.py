@@ -32,6 +32,7 @@ __all__ = [
     "Embeddings",
     "choose_threshold",
     "embed_split",
+    "example_groups",
     "offset_statistics",
     "similarity_of",
     "threshold_quality",
@@ -193,6 +194,29 @@ def threshold_quality(embeddings: Embeddings, epsilon: float) -> dict[str, float
         "same_pose_pairs": int(len(same)),
         "one_step_pairs": int(len(step)),
     }
+
+
+def example_groups(
+    embeddings: Embeddings, triplets: TripletDataset, *, count: int = 3, seed: int = 0
+) -> list[list[str]]:
+    """A few tier-0 triplets as [A, P, extra same-pose views..., N] (up to 3 positives)."""
+    rng = np.random.default_rng(seed)
+    tier0 = [k for k, tier in enumerate(np.asarray(triplets.tiers)) if tier == 0]
+    groups = []
+    index = embeddings.index()
+    for k in rng.permutation(tier0)[:count]:
+        anchor, positive, negative = triplets.obs[int(k)]
+        a = index[anchor]
+        same = np.nonzero(
+            (embeddings.room == embeddings.room[a])
+            & (embeddings.grid_i == embeddings.grid_i[a])
+            & (embeddings.grid_j == embeddings.grid_j[a])
+            & (embeddings.heading == embeddings.heading[a])
+            & (embeddings.layout != embeddings.layout[a])
+        )[0]
+        extra = [embeddings.obs_ids[j] for j in same if embeddings.obs_ids[j] != positive][:2]
+        groups.append([anchor, positive, *extra, negative])
+    return groups
 
 
 def similarity_of(embeddings: Embeddings, ids: list[str]) -> np.ndarray:

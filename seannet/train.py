@@ -50,7 +50,13 @@ def device_for_run() -> torch.device:
     return torch.device("cuda" if torch.cuda.is_available() else "cpu")
 
 
-def build_for_dataset(config: TrainConfig, root: Path, *, pretrained: Path | None = None):  # noqa: ANN201
+def build_for_dataset(  # noqa: ANN201
+    config: TrainConfig,
+    root: Path,
+    *,
+    pretrained: Path | None = None,
+    pretrained_sha256: str | None = None,
+):
     """The model of ``config`` sized for the dataset at ``root`` (its class vocabulary, M)."""
     dataset = open_dataset(root)
     return build_model(
@@ -62,6 +68,7 @@ def build_for_dataset(config: TrainConfig, root: Path, *, pretrained: Path | Non
         embed_dim=config.embed_dim,
         dropout=config.dropout,
         pretrained=pretrained,
+        pretrained_sha256=pretrained_sha256,
     )
 
 
@@ -72,6 +79,7 @@ def train(
     *,
     resume: bool = False,
     pretrained: Path | None = None,
+    pretrained_sha256: str | None = None,
     progress: Callable[[str, int, int, dict[str, float]], None] | None = None,
 ) -> list[EpochResult]:
     """Train ``config.model`` on ``data`` into the run directory ``out``.
@@ -90,7 +98,9 @@ def train(
     val_set = TripletDataset(data, "val", transform=transform)
     device = device_for_run()
     torch.manual_seed(derive_seed(config.seed, INIT_KEY))  # the initial weights
-    model = build_for_dataset(config, data, pretrained=pretrained).to(device)
+    model = build_for_dataset(
+        config, data, pretrained=pretrained, pretrained_sha256=pretrained_sha256
+    ).to(device)
     optimizer = torch.optim.SGD(model.parameters(), lr=config.lr, momentum=config.momentum)
     schedule = torch.optim.lr_scheduler.StepLR(optimizer, config.decay_every, config.lr_decay)
     history: list[dict[str, Any]] = []

@@ -44,6 +44,8 @@ def test_short_run_lowers_the_loss(tmp_path: Path, mini_dataset: Path) -> None:
     assert result["triplets"] == 10 and 0.0 <= result["accuracy"] <= 1.0
     assert set(result["per_tier"]) <= {0, 1, 2, 3, 4}
     assert (tmp_path / "run" / "heat_mean_test.png").read_bytes()[:4] == b"\x89PNG"
+    assert result["examples"] and all(e["ids"][0] != e["ids"][-1] for e in result["examples"])
+    assert (tmp_path / "run" / "examples_test.png").read_bytes()[:4] == b"\x89PNG"
 
 
 def test_resume_continues_exactly(tmp_path: Path, mini_dataset: Path) -> None:
