@@ -1,0 +1,217 @@
+"""Per-view model inputs: the image transform and the scene-graph tensors (DESIGN §8)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import pyarrow as pa
+import torch
+from PIL import Image
+from torch import Tensor
+
+from .batch import NUM_RELATIONS
+from .errors import DataError
+
+__all__ = [
+    "IMAGENET_MEAN",
+    "IMAGENET_STD",
+    "ImageTransform",
+    "dense_adjacency",
+    "graph_from_columns",
+    "graph_tensors",
+    "struct_columns",
+]
+
+# torchvision's ImageNet statistics (RGB, on [0, 1] pixels): what the pretrained ResNet saw.
+IMAGENET_MEAN = (0.485, 0.456, 0.406)
+IMAGENET_STD = (0.229, 0.224, 0.225)
+
+
+# ---------------------------------------------------------------------------------- images
+
+
+@dataclass(frozen=True)
+class ImageTransform:
+    """Resize a view to ``size`` x ``size`` and normalise it the torchvision way.
+
+    The image is resized with Pillow's bilinear filter (antialiased when shrinking), converted
+    to float32 CHW on [0, 1], then normalised per channel as ``(x - mean) / std`` with the
+    ImageNet statistics by default (what torchvision's pretrained ResNet expects). Boxes are
+    scaled by the same factors ``size / width`` and ``size / height``, so they stay in the
+    pixel frame of the resized image (continuous edges, u2 and v2 exclusive). A view already
+    at ``size`` is not resampled.
+    """
+
+    size: int = 224  # output height and width in pixels (SeanNet: 224; a CPU preset: 112)
+    mean: tuple[float, float, float] = IMAGENET_MEAN  # per-channel mean, RGB, [0, 1] scale
+    std: tuple[float, float, float] = IMAGENET_STD  # per-channel std, RGB, [0, 1] scale
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.size, int) or self.size < 1:
+            raise DataError(f"ImageTransform size={self.size!r}; expected a positive integer")
+        if len(self.mean) != 3 or len(self.std) != 3:
+            raise DataError(f"ImageTransform mean/std {self.mean}/{self.std}; expected 3 each")
+        if min(self.std) <= 0:
+            raise DataError(f"ImageTransform std={self.std}; expected positive values")
+
+    def __call__(self, rgb: np.ndarray, boxes: np.ndarray) -> tuple[Tensor, Tensor]:
+        """Transform one view.
+
+        Args:
+            rgb: (H, W, 3) uint8 image.
+            boxes: (K, 4) pixel boxes [u1, v1, u2, v2] in the frame of ``rgb``.
+
+        Returns:
+            ``(image, boxes)``: (3, size, size) float32 and (K, 4) float32 in the new frame.
+        """
+        h, w = rgb.shape[:2]
+        s = self.size
+        if (h, w) != (s, s):
+            rgb = np.asarray(Image.fromarray(rgb).resize((s, s), Image.Resampling.BILINEAR))
+        # (x / 255 - mean) / std as one multiply-add, on the CHW copy of the uint8 pixels
+        std = np.asarray(self.std, dtype=np.float64)
+        scale = (1.0 / (255.0 * std)).astype(np.float32)[:, None, None]
+        offset = (-np.asarray(self.mean, dtype=np.float64) / std).astype(np.float32)[:, None, None]
+        x = np.ascontiguousarray(rgb.transpose(2, 0, 1)).astype(np.float32)
+        x *= scale
+        x += offset
+        image = torch.from_numpy(x)
+        scale = np.asarray([s / w, s / h, s / w, s / h], dtype=np.float32)
+        return image, torch.from_numpy(np.asarray(boxes, dtype=np.float32).reshape(-1, 4) * scale)
+
+
+# ---------------------------------------------------------------------------------- graphs
+
+
+def struct_columns(rows: Any, names: Sequence[str]) -> dict[str, np.ndarray]:
+    """Columns ``names`` of a list of structs, as pyarrow gives it (or as ``to_pylist``)."""
+    if isinstance(rows, pa.ListScalar):
+        rows = rows.values if rows.is_valid else pa.array([], type=rows.type.value_type)
+    if rows is None:
+        rows = []
+    if isinstance(rows, pa.ChunkedArray):
+        rows = rows.combine_chunks()
+    if isinstance(rows, pa.StructArray):
+        children = dict(zip([f.name for f in rows.type], rows.flatten(), strict=True))
+        out = {}
+        for n in names:
+            child = children[n]
+            if pa.types.is_fixed_size_list(child.type):
+                width = child.type.list_size
+                out[n] = child.flatten().to_numpy(zero_copy_only=False).reshape(-1, width)
+            else:
+                out[n] = child.to_numpy(zero_copy_only=False)
+        return out
+    rows = list(rows)
+    return {n: np.asarray([r[n] for r in rows]) for n in names}
+
+
+def graph_tensors(
+    objects: Any, relations: Any, *, num_slots: int
+) -> tuple[Tensor, Tensor, Tensor, Tensor]:
+    """The per-view graph tensors of one observation row.
+
+    Args:
+        objects: the row's ``objects`` list of structs — a ``pyarrow.ListScalar`` (a cell of the
+            column), its ``StructArray`` of values, or the ``to_pylist()`` list of dicts.
+        relations: the row's ``relations`` list of structs, in any of the same forms.
+        num_slots: M, the GCN node slots (the manifest's ``num_slots``).
+
+    Returns:
+        ``(slots, class_ids, boxes, adjacency)``: (K,) long, (K,) long, (K, 4) float32 pixel
+        boxes in the image's own frame (objects in row order), and (3, M, M) float32.
+
+    Adjacency: channel r of ``on``, ``in``, ``proximity`` (relation type codes 0, 1, 2 of the
+    manifest's ``relation_types``; ``disjoint`` (3) is not fed) holds
+    ``A[r, slot(src), slot(dst)] = 1`` for each edge, then each row is divided by its sum, so
+    a node averages over its out-neighbours of that relation; rows without edges (absent
+    nodes included) stay zero. No self-loops are added: the authors' code row-normalised the
+    bare A, and the GCN layers keep a node's own feature through their input to the fusion,
+    not through A.
+
+    Raises:
+        DataError: a slot outside [0, M), two objects sharing a slot, or a relation naming
+            an instance that is not among the row's objects.
+    """
+    obj = struct_columns(objects, ("instance", "class_id", "slot", "box2d"))
+    rel = struct_columns(relations, ("src", "dst", "type"))
+    slots, class_ids, boxes, edge_index, edge_weight = graph_from_columns(
+        obj["instance"],
+        obj["class_id"],
+        obj["slot"],
+        obj["box2d"],
+        rel["src"],
+        rel["dst"],
+        rel["type"],
+        num_slots,
+    )
+    return slots, class_ids, boxes, dense_adjacency(edge_index, edge_weight, num_slots)
+
+
+def dense_adjacency(edge_index: Tensor, edge_weight: Tensor, num_slots: int) -> Tensor:
+    """(3, M, M) adjacency from (3, E) [relation, src slot, dst slot] and (E,) weights."""
+    adjacency = torch.zeros((NUM_RELATIONS, num_slots, num_slots), dtype=torch.float32)
+    adjacency[edge_index[0], edge_index[1], edge_index[2]] = edge_weight
+    return adjacency
+
+
+def graph_from_columns(
+    instance: np.ndarray,
+    class_id: np.ndarray,
+    slot: np.ndarray,
+    box2d: np.ndarray,
+    src: np.ndarray,
+    dst: np.ndarray,
+    rtype: np.ndarray,
+    num_slots: int,
+) -> tuple[Tensor, Tensor, Tensor, Tensor, Tensor]:
+    """:func:`graph_tensors` on numpy columns, the adjacency as a sparse edge list.
+
+    Returns:
+        ``(slots, class_ids, boxes, edge_index, edge_weight)``: edge_index (3, E) long holds
+        [relation, src slot, dst slot] of each distinct fed edge, edge_weight (E,) float32 its
+        row-normalised value (1 / out-degree of the source in that relation).
+    """
+    m = num_slots
+    slot = np.asarray(slot, dtype=np.int64)
+    if slot.size and (slot.min() < 0 or slot.max() >= m):
+        bad = int(slot.min()) if slot.min() < 0 else int(slot.max())
+        raise DataError(f"object slot {bad} out of range; expected 0 <= slot < {m}")
+    if np.unique(slot).size != slot.size:
+        raise DataError("two objects of one view share a GCN slot; slots must be unique")
+    rtype = np.asarray(rtype, dtype=np.int64)
+    fed = rtype < NUM_RELATIONS  # 'disjoint' and any later type are not GCN pathways
+    edge_index = np.zeros((3, 0), dtype=np.int64)
+    edge_weight = np.zeros(0, dtype=np.float32)
+    if fed.any():
+        instance = np.asarray(instance, dtype=np.int64)
+        order = np.argsort(instance, kind="stable")
+        keys = instance[order]
+        ends = np.concatenate((np.asarray(src)[fed], np.asarray(dst)[fed])).astype(np.int64)
+        pos = np.searchsorted(keys, ends)
+        pos_ok = np.minimum(pos, max(keys.size - 1, 0))
+        found = (pos < keys.size) & (keys[pos_ok] == ends) if keys.size else pos < 0
+        if not found.all():
+            missing = int(ends[~found][0])
+            raise DataError(f"a relation names instance {missing}, not among the row's objects")
+        ends_slot = slot[order][pos]
+        n = int(fed.sum())
+        # distinct (relation, src, dst) cells, then 1 / out-degree per (relation, src) row
+        cell = np.unique((rtype[fed] * m + ends_slot[:n]) * m + ends_slot[n:])
+        row = cell // m
+        _, inverse, degree = np.unique(row, return_inverse=True, return_counts=True)
+        edge_index = np.stack((row // m, row % m, cell % m))
+        edge_weight = (1.0 / degree[inverse]).astype(np.float32)
+    return (
+        torch.from_numpy(slot),
+        torch.from_numpy(np.asarray(class_id, dtype=np.int64)),
+        torch.from_numpy(np.asarray(box2d, dtype=np.float32).reshape(-1, 4)),
+        torch.from_numpy(edge_index),
+        torch.from_numpy(edge_weight),
+    )
+
+
+# ---------------------------------------------------------------------------------- items
