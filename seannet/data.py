@@ -301,6 +301,22 @@ def _call(fn: Any, *args: Any, **kwargs: Any) -> Any:
 # ---------------------------------------------------------------------------------- datasets
 
 
+def _open_split(
+    target: TripletDataset | ObservationDataset,
+    root: str | Path,
+    split: str,
+    transform: ImageTransform | None,
+) -> Dataset:
+    """The attributes both datasets share: root, split, transform, identity and view store."""
+    ds = open_dataset(root)
+    target.root = Path(root)
+    target.split = split
+    target.transform = transform or ImageTransform()
+    target.identity = dataset_identity(ds)
+    target._store = _ViewStore(ds, split, target.transform)
+    return ds
+
+
 class TripletDataset(TorchDataset):
     """The triplets of one split; item ``i`` is triplet ``i`` as a :class:`TripletItem`.
 
@@ -324,13 +340,8 @@ class TripletDataset(TorchDataset):
     def __init__(
         self, root: str | Path, split: str, *, transform: ImageTransform | None = None
     ) -> None:
-        ds = open_dataset(root)
-        self.root = Path(root)
-        self.split = split
-        self.transform = transform or ImageTransform()
-        self.identity = dataset_identity(ds)
+        ds = _open_split(self, root, split, transform)
         table = _call(ds.triplets, split)
-        self._store = _ViewStore(ds, split, self.transform)
         self.triplet_ids = table.column("triplet_id").to_numpy().astype(np.int64)
         self.tiers = table.column("tier").to_numpy().astype(np.int64)
         self.room_ids: list[str] = table.column("room_id").to_pylist()
@@ -381,12 +392,7 @@ class ObservationDataset(TorchDataset):
     def __init__(
         self, root: str | Path, split: str, *, transform: ImageTransform | None = None
     ) -> None:
-        ds = open_dataset(root)
-        self.root = Path(root)
-        self.split = split
-        self.transform = transform or ImageTransform()
-        self.identity = dataset_identity(ds)
-        self._store = _ViewStore(ds, split, self.transform)
+        _open_split(self, root, split, transform)
 
     def __len__(self) -> int:
         return len(self._store.obs_ids)
