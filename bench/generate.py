@@ -41,8 +41,8 @@ test = 0
 
 def run_one(rooms: int, workers: int) -> dict:
     """Generate in this process; report counts, times and peak memory (MiB)."""
-    from sgdata.config import load_config
-    from sgdata.generate import generate_dataset
+    from sgdata.pipeline.config import load_config
+    from sgdata.pipeline.generate import generate_dataset
 
     with tempfile.TemporaryDirectory() as tmp:
         config_path = Path(tmp) / "bench.toml"

@@ -33,8 +33,8 @@ from sgdata.dataset import Dataset, decode_image  # noqa: E402
 
 
 def generate_tiny(root: Path) -> None:
-    from sgdata.config import load_config
-    from sgdata.generate import generate_dataset
+    from sgdata.pipeline.config import load_config
+    from sgdata.pipeline.generate import generate_dataset
 
     print(f"generating the tiny preset into {root} ...", flush=True)
     generate_dataset(load_config("tiny"), root, workers=2)

@@ -1,7 +1,7 @@
 """Views per second: bare pyrender passes (RGB, id) against the full view pipeline.
 
     python bench/render.py --synthetic            # the tests' tiny room, runs today
-    python bench/render.py --rooms 2 --views 40   # generated rooms (sgdata.rooms + usd_io)
+    python bench/render.py --rooms 2 --views 40   # generated rooms (sgdata.world.rooms + usd_io)
     LP_NUM_THREADS=1 python bench/render.py --synthetic
 
 Prints frames per second of the RGB pass, the id pass, both (what the pipeline must do) and
@@ -23,12 +23,13 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from sgdata.meshes import SceneGeometry  # noqa: E402
-from sgdata.poses import pose_grid  # noqa: E402
-from sgdata.render import Renderer  # noqa: E402
-from sgdata.scene import Room  # noqa: E402
-from sgdata.slots import SlotTable  # noqa: E402
-from sgdata.views import ViewAnnotator, ViewPose  # noqa: E402
+from sgdata.annotate.annotator import ViewAnnotator  # noqa: E402
+from sgdata.annotate.records import ViewPose  # noqa: E402
+from sgdata.annotate.slots import SlotTable  # noqa: E402
+from sgdata.render.renderer import Renderer  # noqa: E402
+from sgdata.usd.meshes import SceneGeometry  # noqa: E402
+from sgdata.world.poses import pose_grid  # noqa: E402
+from sgdata.world.scene import Room  # noqa: E402
 
 
 def synthetic_scenes() -> list[tuple[Room, SceneGeometry]]:
@@ -40,10 +41,10 @@ def synthetic_scenes() -> list[tuple[Room, SceneGeometry]]:
 
 
 def generated_scenes(n: int, seed: int) -> list[tuple[Room, SceneGeometry]]:
-    from sgdata import usd_io
-    from sgdata.catalog import load_catalog
-    from sgdata.rooms import generate_room
-    from sgdata.usd_geometry import read_geometry
+    from sgdata.usd import room_io as usd_io
+    from sgdata.usd.geometry import read_geometry
+    from sgdata.world.catalog import load_catalog
+    from sgdata.world.rooms import generate_room
 
     catalog = load_catalog()
     types = ["kitchen", "living_room", "bedroom", "bathroom"]

@@ -2,17 +2,15 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Annotated
 
 import typer
 from rich.console import Console
 from rich.table import Table
+from sgdata_cli.errors import run_app
 
 from sgdata.errors import SgdataError
-
-from .errors import run_app
 
 app = typer.Typer(
     name="seannet",
@@ -62,7 +60,13 @@ def train(
             bar.update(task, description=f"{phase} {text}", completed=step, total=total)
 
         results = run_training(
-            config, data, out, resume=resume, pretrained=pretrained, progress=show
+            config,
+            data,
+            out,
+            resume=resume,
+            pretrained=pretrained,
+            pretrained_sha256=pretrained_sha256,
+            progress=show,
         )
     table = Table(title=f"{config.model} on {data} -> {out}")
     for column in ("epoch", "loss", "train acc", "val acc", "lr", "s"):
@@ -103,17 +107,10 @@ def compare(
     split: Annotated[str, typer.Option(help="Split to compare on.")] = "test",
 ) -> None:
     """Train every model with the same preset and budget, evaluate, print one table."""
-    from seannet.config import preset as load_preset
-    from seannet.eval_run import evaluate_run
-    from seannet.train import train as run_training
+    from seannet.compare import COMPARISON, compare_models
 
-    rows = []
-    for name in [m.strip() for m in models.split(",") if m.strip()]:
-        run = out / name
-        config = load_preset(preset).replace(model=name)
-        console.print(f"training {name} ({preset} preset) -> {run}")
-        run_training(config, data, run, resume=(run / "last.pt").exists())
-        rows.append(evaluate_run(run, data, split=split))
+    names = [m.strip() for m in models.split(",") if m.strip()]
+    rows = compare_models(data, out, names, preset=preset, split=split, announce=console.print)
     table = Table(title=f"{split} split of {data}, preset {preset}")
     for column in (
         "model",
@@ -137,7 +134,7 @@ def compare(
             f"{r['threshold_on_split']['recall']:.3f}",
         )
     console.print(table)
-    (out / "comparison.json").write_text(json.dumps(rows, indent=2))
+    console.print(f"wrote {out / COMPARISON}")
 
 
 @app.command()

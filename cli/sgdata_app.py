@@ -10,8 +10,7 @@ import numpy as np
 import typer
 from rich.console import Console
 from rich.table import Table
-
-from .errors import run_app
+from sgdata_cli.errors import run_app
 
 app = typer.Typer(
     name="sgdata",
@@ -37,9 +36,9 @@ def rooms(
     ] = None,
 ) -> None:
     """Generate procedural rooms and write them as USD stages."""
-    from sgdata.catalog import load_catalog
-    from sgdata.rooms import room_stats
-    from sgdata.scenes import write_rooms
+    from sgdata.usd.scene_dirs import write_rooms
+    from sgdata.world.catalog import load_catalog
+    from sgdata.world.rooms import room_stats
 
     classes = load_catalog(catalog)
     made = write_rooms(
@@ -69,8 +68,8 @@ def layouts(
     seed: Annotated[int, typer.Option(help="Seed of the layouts (mixed with the room's).")] = 0,
 ) -> None:
     """Sample layouts of a room under the dynamics rules and write them as USD layers."""
-    from sgdata.dynamics import summarize_layouts
-    from sgdata.scenes import write_layouts
+    from sgdata.usd.scene_dirs import write_layouts
+    from sgdata.world.dynamics import summarize_layouts
 
     made = write_layouts(room_dir, count=count, seed=seed)
     table = Table(title=f"{len(made)} layout(s) of {room_dir}")
@@ -99,8 +98,8 @@ def preview(
     ] = False,
 ) -> None:
     """Write a top-down picture of a room or layout with class labels."""
-    from sgdata.preview import draw_layout_pair, draw_room, save_png
-    from sgdata.usd_io import read_room
+    from sgdata.pictures.preview import draw_layout_pair, draw_room, save_png
+    from sgdata.usd.room_io import read_room
 
     room = read_room(stage)
     if compare:
@@ -127,8 +126,8 @@ def generate(
     """Generate a dataset: rooms, layouts, rendered views, cascaded triplets, Parquet."""
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-    from sgdata.config import load_config
-    from sgdata.generate import generate_dataset
+    from sgdata.pipeline.config import load_config
+    from sgdata.pipeline.generate import generate_dataset
 
     settings = load_config(config)
     workers = workers or os.cpu_count() or 1
@@ -180,9 +179,9 @@ def render(
     from PIL import Image
 
     from sgdata.errors import ConfigError
-    from sgdata.overlay import draw_overlay
-    from sgdata.preview import save_png
-    from sgdata.snapshot import render_snapshot
+    from sgdata.pictures.overlay import draw_overlay
+    from sgdata.pictures.preview import save_png
+    from sgdata.pipeline.snapshot import render_snapshot
 
     cell, heading = None, 0
     if pose:
@@ -249,7 +248,7 @@ def report(
     seed: Annotated[int, typer.Option(help="Seed of the triplet draw.")] = 0,
 ) -> None:
     """Write histograms, a contact sheet of random triplets and summary.md for a dataset."""
-    from sgdata.report import write_report
+    from sgdata.pictures.report import write_report
 
     written = write_report(root, output, triplets=triplets, seed=seed)
     for path in written:

@@ -1,10 +1,10 @@
 """SeanNet: the scene-embedding network and its trainer (PyTorch side)."""
 
-from .backbones import ENCODER_NAMES, ResNetSplit, image_encoder, resnet_c4
-from .baselines import ImageEncoder
-from .batch import NUM_RELATIONS, SceneBatch
-from .config import PRESETS, TrainConfig, preset
-from .data import (
+from seannet.backbones import ENCODER_NAMES, ResNetSplit, image_encoder, resnet_c4
+from seannet.baselines import ImageEncoder
+from seannet.batch import NUM_RELATIONS, SceneBatch
+from seannet.config import PRESETS, TrainConfig, preset
+from seannet.data import (
     ImageTransform,
     ObservationDataset,
     TripletDataset,
@@ -12,13 +12,13 @@ from .data import (
     collate_views,
     dataset_identity,
 )
-from .errors import CheckpointError, DataError, ModelError, SeannetError
-from .eval_run import evaluate_run
-from .loss import TripletLoss, similarity
-from .model import MODEL_NAMES, SeanNet, build_model
-from .pretrained import KNOWN_WEIGHTS, load_pretrained, load_state_dict_file
-from .train import train
-from .wordvectors import (
+from seannet.errors import CheckpointError, DataError, ModelError, SeannetError
+from seannet.eval_run import evaluate_run
+from seannet.loss import TripletLoss, similarity
+from seannet.model import MODEL_NAMES, SeanNet, build_model
+from seannet.pretrained import KNOWN_WEIGHTS, load_pretrained, load_state_dict_file
+from seannet.train import train
+from seannet.wordvectors import (
     WordVectorTable,
     build_table,
     load_table,

@@ -13,8 +13,8 @@ from pathlib import Path
 from torch import nn
 from torchvision import models
 
-from .errors import ModelError
-from .pretrained import load_pretrained
+from seannet.errors import ModelError
+from seannet.pretrained import load_pretrained
 
 __all__ = [
     "RESNET_DEPTHS",

@@ -6,9 +6,9 @@ from pathlib import Path
 
 from torch import Tensor, nn
 
-from .backbones import ENCODER_NAMES, image_encoder
-from .batch import SceneBatch
-from .errors import ModelError
+from seannet.backbones import ENCODER_NAMES, image_encoder
+from seannet.batch import SceneBatch
+from seannet.errors import ModelError
 
 __all__ = ["ImageEncoder", "ENCODER_NAMES"]
 

@@ -7,7 +7,7 @@ from dataclasses import dataclass, fields
 import torch
 from torch import Tensor
 
-from .errors import DataError
+from seannet.errors import DataError
 
 __all__ = ["SceneBatch", "NUM_RELATIONS"]
 

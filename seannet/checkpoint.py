@@ -8,9 +8,8 @@ from typing import Any
 
 import torch
 
+from seannet.errors import CheckpointError
 from sgdata.fileio import atomic_write_bytes
-
-from .errors import CheckpointError
 
 __all__ = ["save_checkpoint", "load_checkpoint", "check_same_dataset"]
 

@@ -6,7 +6,7 @@ import dataclasses
 from dataclasses import dataclass
 from typing import Any
 
-from .errors import ModelError
+from seannet.errors import ModelError
 
 __all__ = ["PRESETS", "TrainConfig", "preset"]
 

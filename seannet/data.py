@@ -32,12 +32,9 @@ import torch
 from torch import Tensor
 from torch.utils.data import Dataset as TorchDataset
 
-from sgdata.dataset import Dataset, decode_image
-from sgdata.errors import DatasetError
-
-from .batch import NUM_RELATIONS, SceneBatch
-from .errors import DataError
-from .view_inputs import (
+from seannet.batch import NUM_RELATIONS, SceneBatch
+from seannet.errors import DataError
+from seannet.view_inputs import (
     IMAGENET_MEAN,
     IMAGENET_STD,
     ImageTransform,
@@ -46,6 +43,8 @@ from .view_inputs import (
     graph_tensors,
     struct_columns,
 )
+from sgdata.dataset import Dataset, decode_image, observations_schema, read_table
+from sgdata.errors import DatasetError
 
 __all__ = [
     "IMAGENET_MEAN",
@@ -185,11 +184,9 @@ class _Shard:
 
     def __init__(self, path: Path) -> None:
         try:
-            table = pq.read_table(path, columns=list(_VIEW_COLUMNS))
-        except (pa.ArrowException, OSError) as exc:
-            raise DataError(
-                _one_line(f"{path}: not a readable observation shard ({exc})")
-            ) from None
+            table = read_table(path, observations_schema(), columns=_VIEW_COLUMNS)
+        except DatasetError as exc:
+            raise DataError(_one_line(str(exc))) from None
         self.images = table.column("image")
         self.obj_offsets, obj = _flatten_lists(
             table.column("objects"), ("instance", "class_id", "slot", "box2d")

@@ -10,13 +10,10 @@ from typing import Any
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
-from sgdata.fileio import atomic_write_text
-from sgdata.preview import save_png
-
-from .checkpoint import check_same_dataset, load_checkpoint
-from .config import TrainConfig
-from .data import ImageTransform, TripletDataset, dataset_identity
-from .evaluate import (
+from seannet.checkpoint import check_same_dataset, load_checkpoint
+from seannet.config import TrainConfig
+from seannet.data import ImageTransform, TripletDataset, dataset_identity
+from seannet.evaluate import (
     MAX_OFFSET,
     choose_threshold,
     embed_split,
@@ -26,7 +23,9 @@ from .evaluate import (
     threshold_quality,
     triplet_metrics,
 )
-from .train import BEST, build_for_dataset, device_for_run
+from seannet.train import BEST, build_for_dataset, device_for_run
+from sgdata.fileio import atomic_write_text
+from sgdata.pictures.preview import save_png
 
 __all__ = ["evaluate_run", "draw_heatmap"]
 

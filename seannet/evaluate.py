@@ -24,9 +24,9 @@ import numpy as np
 import torch
 from torch.utils.data import DataLoader
 
-from .config import TrainConfig
-from .data import ImageTransform, ObservationDataset, TripletDataset, collate_views
-from .loss import similarity
+from seannet.config import TrainConfig
+from seannet.data import ImageTransform, ObservationDataset, TripletDataset, collate_views
+from seannet.loss import similarity
 
 __all__ = [
     "Embeddings",

@@ -8,7 +8,7 @@ import torch
 from torch import Tensor, nn
 from torch.nn import functional as F
 
-from .errors import ModelError
+from seannet.errors import ModelError
 
 __all__ = ["similarity", "TripletLoss"]
 

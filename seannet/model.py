@@ -10,12 +10,12 @@ import torch
 from torch import Tensor, nn
 from torchvision.ops import roi_align
 
-from .backbones import ENCODER_NAMES, resnet_c4
-from .baselines import ImageEncoder
-from .batch import NUM_RELATIONS, SceneBatch
-from .errors import ModelError
-from .layers import MultiPathwayGCN, ObjectEmbedding
-from .wordvectors import WordVectorTable
+from seannet.backbones import ENCODER_NAMES, resnet_c4
+from seannet.baselines import ImageEncoder
+from seannet.batch import NUM_RELATIONS, SceneBatch
+from seannet.errors import ModelError
+from seannet.layers import MultiPathwayGCN, ObjectEmbedding
+from seannet.wordvectors import WordVectorTable
 
 __all__ = ["SeanNet", "MODEL_NAMES", "build_model"]
 
@@ -200,11 +200,11 @@ def build_model(
     if name != "seannet":
         raise ModelError(f"model {name!r}; expected one of {', '.join(MODEL_NAMES)}")
     if word_vectors is None:
-        from .wordvectors import load_table
+        from seannet.wordvectors import load_table
 
         word_vectors = load_table()
     if class_names is None:
-        from sgdata.catalog import load_catalog
+        from sgdata.world.catalog import load_catalog
 
         class_names = load_catalog().names()
     return SeanNet(

@@ -16,9 +16,15 @@ from pathlib import Path
 import torch
 from torch import Tensor, nn
 
-from .errors import ModelError
+from seannet.errors import ModelError
 
-__all__ = ["KNOWN_WEIGHTS", "file_sha256", "load_state_dict_file", "load_pretrained"]
+__all__ = [
+    "KNOWN_WEIGHTS",
+    "check_pretrained_request",
+    "file_sha256",
+    "load_state_dict_file",
+    "load_pretrained",
+]
 
 # torchvision's ImageNet weight files: architecture -> {file name: sha256 prefix}. The prefix
 # is the one torchvision embeds in the file name (torchvision 0.29 model URLs).
@@ -35,6 +41,26 @@ KNOWN_WEIGHTS: dict[str, dict[str, str]] = {
 }
 
 _HEX = re.compile(r"[0-9a-f]{8,64}")
+
+
+def check_pretrained_request(path: Path | None, sha256: str | None) -> None:
+    """Refuse an expected SHA-256 that cannot be used, before any work starts.
+
+    Raises:
+        ModelError: ``sha256`` is given without a weights file, or is not 64 hex digits.
+    """
+    if sha256 is None:
+        return
+    if path is None:
+        raise ModelError(
+            f"--pretrained-sha256 {sha256}: given without --pretrained PATH; "
+            "pass the weights file it checks, or drop it"
+        )
+    if not _HEX.fullmatch(sha256.strip().lower()):
+        raise ModelError(
+            f"--pretrained-sha256 {sha256!r}: expected 8 to 64 hex digits of the file's "
+            f"sha256 (`sha256sum {path}`)"
+        )
 
 
 def file_sha256(path: Path) -> str:

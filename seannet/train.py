@@ -17,20 +17,25 @@ from typing import Any
 import torch
 from torch.utils.data import DataLoader, Subset
 
+from seannet.checkpoint import check_same_dataset, load_checkpoint, save_checkpoint
+from seannet.config import TrainConfig
+from seannet.data import (
+    ImageTransform,
+    TripletDataset,
+    collate_triplets,
+    dataset_identity,
+    open_dataset,
+)
+from seannet.errors import CheckpointError
+from seannet.loss import TripletLoss, similarity
+from seannet.model import build_model
+from seannet.pretrained import check_pretrained_request
 from sgdata.fileio import atomic_write_text
-from sgdata.seeds import derive_seed
-
-from .checkpoint import check_same_dataset, load_checkpoint, save_checkpoint
-from .config import TrainConfig
-from .data import ImageTransform, TripletDataset, collate_triplets, dataset_identity, open_dataset
-from .errors import CheckpointError
-from .loss import TripletLoss, similarity
-from .model import build_model
+from sgdata.seeds import epoch_dropout_seed, epoch_order_seed, init_seed
 
 __all__ = ["EpochResult", "train", "build_for_dataset", "device_for_run"]
 
 LAST, BEST, HISTORY = "last.pt", "best.pt", "history.json"
-INIT_KEY = 1 << 20  # seed path of the initial weights (epochs use 0, 1, 2, ...)
 
 
 @dataclass(frozen=True)
@@ -91,13 +96,15 @@ def train(
         CheckpointError: ``resume`` without a checkpoint, a different config, or a different
             dataset than the checkpoint's; ``out`` holds a run and ``resume`` is off.
         DataError: the dataset is missing or malformed.
+        ModelError: ``pretrained_sha256`` without ``pretrained``, or not 64 hex digits.
     """
+    check_pretrained_request(pretrained, pretrained_sha256)
     identity = dataset_identity(data)
     transform = ImageTransform(size=config.image_size)
     train_set = TripletDataset(data, "train", transform=transform)
     val_set = TripletDataset(data, "val", transform=transform)
     device = device_for_run()
-    torch.manual_seed(derive_seed(config.seed, INIT_KEY))  # the initial weights
+    torch.manual_seed(init_seed(config.seed))  # the initial weights
     model = build_for_dataset(
         config, data, pretrained=pretrained, pretrained_sha256=pretrained_sha256
     ).to(device)
@@ -162,11 +169,11 @@ def _train_epoch(
     device: torch.device,
     progress: Callable[[str, int, int, dict[str, float]], None] | None,
 ) -> tuple[float, float]:
-    order = torch.Generator().manual_seed(derive_seed(config.seed, epoch, 0))
+    order = torch.Generator().manual_seed(epoch_order_seed(config.seed, epoch))
     indices = torch.randperm(len(dataset), generator=order).tolist()
     if config.max_train_batches:
         indices = indices[: config.max_train_batches * config.batch_size]
-    torch.manual_seed(derive_seed(config.seed, epoch, 1))  # dropout masks of this epoch
+    torch.manual_seed(epoch_dropout_seed(config.seed, epoch))  # dropout masks of this epoch
     loader = DataLoader(
         Subset(dataset, indices),
         batch_size=config.batch_size,

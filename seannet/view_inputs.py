@@ -12,8 +12,8 @@ import torch
 from PIL import Image
 from torch import Tensor
 
-from .batch import NUM_RELATIONS
-from .errors import DataError
+from seannet.batch import NUM_RELATIONS
+from seannet.errors import DataError
 
 __all__ = [
     "IMAGENET_MEAN",

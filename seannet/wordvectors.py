@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from .errors import DataError
+from seannet.errors import DataError
 
 __all__ = [
     "SOURCES",
@@ -348,7 +348,7 @@ def write_word_vectors(
         catalog: an ``sgdata.catalog.Catalog`` (default: the shipped catalog).
     """
     if catalog is None:
-        from sgdata.catalog import load_catalog
+        from sgdata.world.catalog import load_catalog
 
         catalog = load_catalog()
     table = build_table(catalog.names(), source)

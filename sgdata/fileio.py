@@ -6,7 +6,7 @@ import os
 import tempfile
 from pathlib import Path
 
-from .errors import ConfigError
+from sgdata.errors import ConfigError
 
 __all__ = [
     "TEMP_GLOB",

@@ -1,10 +1,37 @@
-"""Seed derivation: every random draw flows from the dataset seed through named child seeds."""
+"""Seed derivation: every random draw flows from the dataset seed through named child seeds.
+
+This module is the one home of every derivation path, so two stages can never draw from the
+same stream by accident and a path never changes without this file changing::
+
+    dataset seed ─┬─ room_seed(type index, room index) ─┬─ layouts_seed(request) ─ layout_seed(k)
+                  │                                     └─ view_seed(layout, i, j, heading)
+                  └─ split_triplets_seed(split) ─ triplet_stream_seed(split, room, tier)
+    training seed ─ init_seed() / epoch_order_seed(epoch) / epoch_dropout_seed(epoch)
+"""
 
 from __future__ import annotations
 
+import hashlib
+
 import numpy as np
 
-__all__ = ["derive_seed", "rng_for"]
+__all__ = [
+    "derive_seed",
+    "rng_for",
+    "name_key",
+    "room_seed",
+    "layouts_seed",
+    "layout_seed",
+    "view_seed",
+    "split_triplets_seed",
+    "triplet_stream_seed",
+    "init_seed",
+    "epoch_order_seed",
+    "epoch_dropout_seed",
+]
+
+_TRIPLETS = "triplets"  # the purpose key of triplet streams
+_INIT = 1 << 20  # the initial weights (epochs use 0, 1, 2, ...)
 
 
 def derive_seed(parent: int, *keys: int) -> int:
@@ -20,3 +47,54 @@ def derive_seed(parent: int, *keys: int) -> int:
 def rng_for(seed: int) -> np.random.Generator:
     """The generator all draws of one unit of work (a room, a layout, a view) come from."""
     return np.random.default_rng(seed)
+
+
+def name_key(name: str) -> int:
+    """A stable 63-bit key of a string (Python's ``hash()`` is salted per run)."""
+    digest = hashlib.blake2b(name.encode("utf-8"), digest_size=8).digest()
+    return int.from_bytes(digest, "big") >> 1
+
+
+def room_seed(dataset_seed: int, type_index: int, index: int) -> int:
+    """A room's seed: its type's position in the room-type list and its number in the type."""
+    return derive_seed(dataset_seed, type_index, index)
+
+
+def layouts_seed(room: int, request: int) -> int:
+    """The seed of one request for layouts of a room (``sgdata layouts --seed``)."""
+    return derive_seed(room, request)
+
+
+def layout_seed(layouts: int, index: int) -> int:
+    """Layout ``index``'s own seed, from the seed of its request."""
+    return derive_seed(layouts, index)
+
+
+def view_seed(room: int, layout: int, i: int, j: int, heading: int) -> int:
+    """One view's seed (pose noise, light jitter), from its room's seed and its pose key."""
+    return derive_seed(room, layout, i, j, heading)
+
+
+def split_triplets_seed(dataset_seed: int, split_index: int) -> int:
+    """The seed of a split's triplets (``split_index`` counts train = 0, val = 1, test = 2)."""
+    return derive_seed(dataset_seed, 1 + split_index)
+
+
+def triplet_stream_seed(split_seed: int, split: str, room_id: str, tier: int) -> int:
+    """The stream of one room's triplets of one tier (by names, so adding a room moves none)."""
+    return derive_seed(split_seed, name_key(_TRIPLETS), name_key(split), name_key(room_id), tier)
+
+
+def init_seed(training_seed: int) -> int:
+    """The seed of a model's initial weights."""
+    return derive_seed(training_seed, _INIT)
+
+
+def epoch_order_seed(training_seed: int, epoch: int) -> int:
+    """The seed of an epoch's batch order."""
+    return derive_seed(training_seed, epoch, 0)
+
+
+def epoch_dropout_seed(training_seed: int, epoch: int) -> int:
+    """The seed of an epoch's dropout masks."""
+    return derive_seed(training_seed, epoch, 1)

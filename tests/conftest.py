@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 import trimesh
 
-from sgdata.meshes import MeshData, ObjectGeometry, SceneGeometry
-from sgdata.scene import Dynamics, Opening, Placement, Room, SceneObject
+from sgdata.usd.meshes import MeshData, ObjectGeometry, SceneGeometry
+from sgdata.world.scene import Dynamics, Opening, Placement, Room, SceneObject
 
 # The camera pose from which the tiny room's interesting objects are all in view.
 TINY_VIEW = (2.5, 0.5, np.pi / 2)  # x, y, theta: standing near the south wall, looking north
@@ -151,7 +151,7 @@ def tiny_room() -> TinyRoom:
 @pytest.fixture(scope="session")
 def renderer() -> Iterator[object]:
     """One EGL renderer for the whole session (building contexts is slow)."""
-    from sgdata.render import Renderer
+    from sgdata.render.renderer import Renderer
 
     r = Renderer()
     yield r
@@ -212,8 +212,8 @@ def mini_config_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
 @pytest.fixture(scope="session")
 def mini_dataset(tmp_path_factory: pytest.TempPathFactory, mini_config_file: Path) -> Path:
     """Root of the generated mini dataset (real USD, Parquet and PNG)."""
-    from sgdata.config import load_config
-    from sgdata.generate import generate_dataset
+    from sgdata.pipeline.config import load_config
+    from sgdata.pipeline.generate import generate_dataset
 
     root = tmp_path_factory.mktemp("mini_dataset") / "data"
     generate_dataset(load_config(mini_config_file), root, workers=2)

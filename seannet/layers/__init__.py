@@ -1,8 +1,8 @@
 """SeanNet's layers, one per module: box encoding, object embedding, multi-pathway GCN."""
 
-from .box_encoding import BoxEncoding, sinusoidal_encoding
-from .gcn import GCNLayer, GCNPathway, MultiPathwayGCN
-from .object_embedding import ObjectEmbedding
+from seannet.layers.box_encoding import BoxEncoding, sinusoidal_encoding
+from seannet.layers.gcn import GCNLayer, GCNPathway, MultiPathwayGCN
+from seannet.layers.object_embedding import ObjectEmbedding
 
 __all__ = [
     "BoxEncoding",

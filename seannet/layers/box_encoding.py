@@ -7,7 +7,7 @@ import math
 import torch
 from torch import Tensor, nn
 
-from ..errors import ModelError
+from seannet.errors import ModelError
 
 __all__ = ["sinusoidal_encoding", "BoxEncoding"]
 

@@ -8,7 +8,7 @@ from collections.abc import Sequence
 import torch
 from torch import Tensor, nn
 
-from ..errors import ModelError
+from seannet.errors import ModelError
 
 __all__ = ["GCNLayer", "GCNPathway", "MultiPathwayGCN"]
 

@@ -7,8 +7,8 @@ from collections.abc import Sequence
 import torch
 from torch import Tensor, nn
 
-from ..errors import ModelError
-from .box_encoding import BoxEncoding
+from seannet.errors import ModelError
+from seannet.layers.box_encoding import BoxEncoding
 
 __all__ = ["ObjectEmbedding"]
 

@@ -18,12 +18,12 @@ from typing import Any
 
 import jsonschema
 
-from ..errors import DatasetError
-from ..fileio import atomic_write_text
-from ..relations import RelationType
-from ..schema import FORMAT_VERSION, manifest_json_schema, migrate_manifest_dict
-from .layout import MANIFEST, SPLITS
-from .rows import sha256_file
+from sgdata.annotate.relations import RelationType
+from sgdata.dataset.paths import MANIFEST, SPLITS
+from sgdata.dataset.rows import sha256_file
+from sgdata.dataset.schema import FORMAT_VERSION, manifest_json_schema, migrate_manifest_dict
+from sgdata.errors import DatasetError
+from sgdata.fileio import atomic_write_text
 
 __all__ = [
     "FORMAT_NAME",

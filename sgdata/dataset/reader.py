@@ -15,13 +15,13 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 from PIL import Image
 
-from ..errors import DatasetError
-from ..schema import observations_schema, triplets_schema
-from .layout import MANIFEST, observations_path, triplets_path
-from .manifest import Manifest, read_manifest
-from .rows import sha256_file
+from sgdata.dataset.manifest import Manifest, read_manifest
+from sgdata.dataset.paths import MANIFEST, observations_path, triplets_path
+from sgdata.dataset.rows import sha256_file
+from sgdata.dataset.schema import FORMAT_VERSION, observations_schema, triplets_schema
+from sgdata.errors import DatasetError
 
-__all__ = ["Dataset", "decode_image"]
+__all__ = ["Dataset", "decode_image", "read_table"]
 
 
 def decode_image(data: bytes) -> np.ndarray:
@@ -39,10 +39,56 @@ def decode_image(data: bytes) -> np.ndarray:
         ) from None
 
 
+def read_table(
+    path: Path, schema: pa.Schema, *, columns: Sequence[str] | None = None, cast: bool = False
+) -> pa.Table:
+    """Read ``columns`` (default: every column of ``schema``) of one Parquet file of the format.
+
+    The one reader of observation and triplet files: :class:`Dataset`, ``sgdata validate`` and
+    the training loader all come through here. Columns the file has beyond the schema (a newer
+    minor format) are not read.
+
+    Args:
+        cast: cast columns whose type differs but converts (``validate`` reports the type
+            separately); otherwise a differing column is an error.
+
+    Raises:
+        DatasetError: the file is missing, unreadable, lacks a column, or a column differs
+            from the schema (and does not cast, with ``cast``).
+    """
+    name = schema.metadata[b"name"].decode() if schema.metadata else "sgdata"
+    if not path.is_file():
+        raise DatasetError(
+            f"{path}: listed by {MANIFEST} but missing; the dataset is incomplete "
+            "(copy it again, or run sgdata generate --resume)"
+        )
+    names = list(schema.names if columns is None else columns)
+    expected = pa.schema([schema.field(n) for n in names])
+    try:
+        found = pq.read_schema(path)
+        missing = [n for n in names if n not in found.names]
+        if missing:
+            raise DatasetError(
+                f"{path}: no column(s) {missing}; not a format {FORMAT_VERSION} {name} table"
+            )
+        table = pq.read_table(path, columns=names)
+        if cast and not table.schema.equals(expected):
+            table = table.cast(expected)
+    except (pa.ArrowException, OSError, ValueError) as exc:
+        raise DatasetError(f"{path}: not a readable Parquet file of {name} ({exc})") from None
+    if not table.schema.equals(expected):
+        wrong = [f.name for f in table.schema if not f.equals(expected.field(f.name))]
+        raise DatasetError(
+            f"{path}: column(s) {wrong} differ from the format {FORMAT_VERSION} schema "
+            "(see docs/dataset.md)"
+        )
+    return table
+
+
 class Dataset:
     """An sgdata dataset on disk; open it with :meth:`Dataset.open`.
 
-    Tables come back as ``pyarrow.Table`` with the schemas of :mod:`sgdata.schema`; convert
+    Tables come back as ``pyarrow.Table`` with the schemas of :mod:`sgdata.dataset.schema`; convert
     with ``.to_pandas()`` or ``polars.from_arrow`` as needed.
     """
 
@@ -119,37 +165,6 @@ class Dataset:
         """The observation shards of ``split``, one per room, in manifest room order."""
         return [self._root / observations_path(split, room) for room in self._split(split)]
 
-    def _read(self, path: Path, columns: Sequence[str] | None, schema: pa.Schema) -> pa.Table:
-        """Read ``columns`` (default: every column of ``schema``) of one file and check them.
-
-        Columns the file has beyond the schema (a newer minor format) are not read.
-        """
-        if not path.is_file():
-            raise DatasetError(
-                f"{path}: listed by {MANIFEST} but missing; the dataset is incomplete "
-                "(copy it again, or run sgdata generate --resume)"
-            )
-        names = list(schema.names if columns is None else columns)
-        try:
-            found = pq.read_schema(path)
-            missing = [n for n in names if n not in found.names]
-            if missing:
-                raise DatasetError(
-                    f"{path}: no column(s) {missing}; not a format "
-                    f"{self._manifest.format_version} {schema.metadata[b'name'].decode()} table"
-                )
-            table = pq.read_table(path, columns=names)
-        except (pa.ArrowException, OSError) as exc:
-            raise DatasetError(f"{path}: not a readable Parquet file ({exc})") from None
-        expected = pa.schema([schema.field(n) for n in names])
-        if not table.schema.equals(expected):
-            wrong = [f.name for f in table.schema if not f.equals(expected.field(f.name))]
-            raise DatasetError(
-                f"{path}: column(s) {wrong} differ from the format "
-                f"{self._manifest.format_version} schema (see docs/dataset.md)"
-            )
-        return table
-
     def observations(self, split: str, *, columns: Sequence[str] | None = None) -> pa.Table:
         """All observation rows of ``split`` (its room shards concatenated in room order).
 
@@ -161,7 +176,7 @@ class Dataset:
             unknown = [c for c in columns if c not in schema.names]
             if unknown:
                 raise DatasetError(f"unknown observation columns {unknown}; known: {schema.names}")
-        tables = [self._read(p, columns, schema) for p in self.observation_files(split)]
+        tables = [read_table(p, schema, columns=columns) for p in self.observation_files(split)]
         if not tables:
             names = schema.names if columns is None else list(columns)
             return pa.schema([schema.field(n) for n in names]).empty_table()
@@ -170,7 +185,7 @@ class Dataset:
     def triplets(self, split: str) -> pa.Table:
         """The triplets of ``split`` (``triplet_id`` is the row index)."""
         self._split(split)
-        return self._read(self._root / triplets_path(split), None, triplets_schema())
+        return read_table(self._root / triplets_path(split), triplets_schema())
 
     # ------------------------------------------------------------------ images and checks
 

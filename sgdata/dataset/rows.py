@@ -22,11 +22,11 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 from PIL import Image
 
-from ..errors import DatasetError
-from ..schema import observations_schema, triplets_schema
-from ..triplets import Triplet
-from ..views import ViewRecord
-from .layout import SCENE_LAYER, obs_id
+from sgdata.annotate.records import ViewRecord
+from sgdata.dataset.paths import SCENE_LAYER, obs_id
+from sgdata.dataset.schema import observations_schema, triplets_schema
+from sgdata.errors import DatasetError
+from sgdata.world.triplets import Triplet
 
 __all__ = [
     "IMAGE_FORMATS",

@@ -11,15 +11,20 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from ..schema import FORMAT_VERSION, _parse_version
-from .composition_checks import check_rooms_across_splits, check_triplets
-from .image_checks import check_images
-from .logic_checks import check_objects, check_relations, check_rows
-from .manifest_checks import check_files, check_manifest, check_splits, read_raw_manifest
-from .relation_checks import check_recompute
-from .report_types import Collector, Problem, ValidationReport
-from .scene_checks import check_scenes
-from .table_checks import check_ids, compare_schema, load_split
+from sgdata.dataset.schema import FORMAT_VERSION, _parse_version
+from sgdata.validate.composition_checks import check_rooms_across_splits, check_triplets
+from sgdata.validate.image_checks import check_images
+from sgdata.validate.logic_checks import check_objects, check_relations, check_rows
+from sgdata.validate.manifest_checks import (
+    check_files,
+    check_manifest,
+    check_splits,
+    read_raw_manifest,
+)
+from sgdata.validate.problems import Collector, Problem, ValidationReport
+from sgdata.validate.relation_checks import check_recompute
+from sgdata.validate.scene_checks import check_scenes
+from sgdata.validate.table_checks import check_ids, compare_schema, load_split
 
 __all__ = ["Problem", "ValidationReport", "compare_schema", "validate_dataset"]
 

@@ -10,10 +10,10 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
 
-from ..dataset.layout import MANIFEST
-from ..triplets import TIERS, tier_counts
-from .loading import SplitTables, column_numpy, fixed_numpy
-from .report_types import Collector
+from sgdata.dataset.paths import MANIFEST
+from sgdata.validate.loading import SplitTables, column_numpy, fixed_numpy
+from sgdata.validate.problems import Collector
+from sgdata.world.triplets import TIERS, tier_counts
 
 __all__ = ["check_triplets", "check_rooms_across_splits", "ROLES"]
 

@@ -11,7 +11,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 from PIL import Image
 
-from .report_types import Collector
+from sgdata.validate.problems import Collector
 
 __all__ = ["check_images", "inspect_image"]
 

@@ -14,7 +14,9 @@ from typing import Any
 import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
-import pyarrow.parquet as pq
+
+from sgdata.dataset.reader import read_table
+from sgdata.errors import DatasetError
 
 __all__ = ["SplitTables", "Flat", "read_table_as", "flatten_list", "fixed_numpy", "column_numpy"]
 
@@ -37,15 +39,13 @@ class SplitTables:
 
 
 def read_table_as(path: Path, schema: pa.Schema, *, skip: tuple[str, ...] = ()) -> pa.Table | None:
-    """``path`` read and cast to ``schema`` (minus ``skip``); None when that is impossible."""
-    wanted = pa.schema([f for f in schema if f.name not in skip])
+    """``path`` read and cast to ``schema`` (minus ``skip``); None when that is impossible
+    (the table checks report why)."""
     try:
-        found = pq.read_schema(path)
-        if any(name not in found.names for name in wanted.names):
-            return None
-        table = pq.read_table(path, columns=wanted.names)
-        return table.cast(wanted) if not table.schema.equals(wanted) else table
-    except (pa.ArrowException, OSError, ValueError):
+        return read_table(
+            path, schema, columns=[n for n in schema.names if n not in skip], cast=True
+        )
+    except DatasetError:
         return None
 
 

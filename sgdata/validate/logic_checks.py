@@ -7,8 +7,8 @@ from typing import Any
 
 import numpy as np
 
-from .loading import Flat, SplitTables, column_numpy, flatten_list
-from .report_types import Collector
+from sgdata.validate.loading import Flat, SplitTables, column_numpy, flatten_list
+from sgdata.validate.problems import Collector
 
 __all__ = ["check_rows", "check_objects", "check_relations"]
 

@@ -11,12 +11,12 @@ import jsonschema
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from ..dataset.layout import MANIFEST
-from ..dataset.manifest import Manifest
-from ..dataset.rows import sha256_file
-from ..errors import DatasetError
-from ..schema import check_compatible, manifest_json_schema
-from .report_types import Collector
+from sgdata.dataset.manifest import Manifest
+from sgdata.dataset.paths import MANIFEST
+from sgdata.dataset.rows import sha256_file
+from sgdata.dataset.schema import check_compatible, manifest_json_schema
+from sgdata.errors import DatasetError
+from sgdata.validate.problems import Collector
 
 __all__ = ["read_raw_manifest", "check_manifest", "check_files", "check_splits"]
 

@@ -12,10 +12,10 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ConfigError
-from ..relations import RelationRules, compute_relations
-from .loading import Flat, SplitTables, column_numpy
-from .report_types import Collector
+from sgdata.annotate.relations import RelationRules, compute_relations
+from sgdata.errors import ConfigError
+from sgdata.validate.loading import Flat, SplitTables, column_numpy
+from sgdata.validate.problems import Collector
 
 __all__ = ["BORDER", "borderline_pairs", "check_recompute"]
 

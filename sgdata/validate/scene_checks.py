@@ -1,5 +1,5 @@
 """Scene checks: every USD layer a row's ``scene`` names exists and composes; with ``usd``,
-USD's own validators run on it too (:func:`sgdata.usd_io.validate_stage`)."""
+USD's own validators run on it too (:func:`sgdata.usd.room_io.validate_stage`)."""
 
 from __future__ import annotations
 
@@ -7,16 +7,16 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import UsdError
-from .loading import SplitTables, column_numpy
-from .report_types import Collector
+from sgdata.errors import UsdError
+from sgdata.validate.loading import SplitTables, column_numpy
+from sgdata.validate.problems import Collector
 
 __all__ = ["check_scenes"]
 
 
 def check_scenes(root: Path, splits: list[SplitTables], out: Collector, *, usd: bool) -> None:
     """Open each distinct referenced scene once; report problems at its first row."""
-    from ..usd_io import open_stage, validate_stage  # pxr only when scenes are checked
+    from sgdata.usd.room_io import open_stage, validate_stage  # pxr only when scenes are checked
 
     first: dict[str, tuple[str, int]] = {}
     for tables in splits:

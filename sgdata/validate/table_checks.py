@@ -11,10 +11,10 @@ import pyarrow as pa
 import pyarrow.compute as pc
 import pyarrow.parquet as pq
 
-from ..dataset.layout import observations_path, triplets_path
-from ..schema import observations_schema, triplets_schema
-from .loading import SplitTables, column_numpy, read_table_as
-from .report_types import Collector
+from sgdata.dataset.paths import observations_path, triplets_path
+from sgdata.dataset.schema import observations_schema, triplets_schema
+from sgdata.validate.loading import SplitTables, column_numpy, read_table_as
+from sgdata.validate.problems import Collector
 
 __all__ = ["compare_schema", "load_split", "check_ids"]
 

@@ -7,7 +7,7 @@ import torch
 
 from seannet import DataError, ModelError, SceneBatch, SeanNet, build_model
 from seannet.wordvectors import load_table
-from sgdata.catalog import load_catalog
+from sgdata.world.catalog import load_catalog
 
 M = 256
 SIZE = 112  # 112² input -> C4 7 x 7 (stride 16)

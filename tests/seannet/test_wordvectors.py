@@ -17,7 +17,7 @@ from seannet.wordvectors import (
     split_camel_case,
     write_word_vectors,
 )
-from sgdata.catalog import load_catalog
+from sgdata.world.catalog import load_catalog
 
 
 @pytest.mark.parametrize(

@@ -6,10 +6,10 @@ from pathlib import Path
 
 import pytest
 
-from sgdata.catalog import Catalog, load_catalog
-from sgdata.room_recipes import ROOM_TYPES
-from sgdata.rooms import generate_room
-from sgdata.scene import Room
+from sgdata.world.catalog import Catalog, load_catalog
+from sgdata.world.room_recipes import ROOM_TYPES
+from sgdata.world.rooms import generate_room
+from sgdata.world.scene import Room
 
 
 @pytest.fixture(scope="session")
@@ -31,7 +31,7 @@ def kitchen(rooms_by_type: dict[str, list[Room]]) -> Room:
 @pytest.fixture(scope="session")
 def kitchen_dir(tmp_path_factory: pytest.TempPathFactory, catalog: Catalog) -> Path:
     """A scene directory holding kitchen_000/room.usda and five layouts."""
-    from sgdata.scenes import write_layouts, write_rooms
+    from sgdata.usd.scene_dirs import write_layouts, write_rooms
 
     out = tmp_path_factory.mktemp("scenes")
     write_rooms(out, "kitchen", count=1, seed=0, catalog=catalog)

@@ -1,0 +1,120 @@
+"""The annotator: render -> visible objects and boxes -> slots -> relations, one view at a time.
+
+It keeps the renderer and the layout's object table alive between views and returns
+:class:`~sgdata.annotate.records.ViewRecord` s.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from sgdata.annotate.boxes import ObjectTable, annotate
+from sgdata.annotate.records import ViewPose, ViewRecord
+from sgdata.annotate.relations import RelationRules, compute_relations
+from sgdata.annotate.slots import SlotTable
+from sgdata.errors import RenderError
+from sgdata.render.camera import CameraConfig
+from sgdata.render.renderer import Renderer
+from sgdata.usd.meshes import SceneGeometry
+from sgdata.world.scene import Room
+
+__all__ = ["ViewAnnotator"]
+
+
+class ViewAnnotator:
+    """Turns poses of one layout at a time into :class:`ViewRecord` s.
+
+    Args:
+        renderer: a live renderer (one per worker, reused for every room).
+        slots: the class slot runs.
+        min_visible_pixels: fewer visible pixels and an object is not in the view.
+        rules: relation rules.
+        keep_depth: keep the depth image in the records.
+    """
+
+    def __init__(
+        self,
+        renderer: Renderer,
+        slots: SlotTable,
+        *,
+        min_visible_pixels: int = 20,
+        rules: RelationRules | None = None,
+        keep_depth: bool = False,
+    ) -> None:
+        self.renderer = renderer
+        self.slots = slots
+        self.min_visible_pixels = int(min_visible_pixels)
+        self.rules = rules or RelationRules()
+        self.keep_depth = keep_depth
+        self._room: Room | None = None
+        self._layout = -1
+        self._table: ObjectTable | None = None
+
+    @property
+    def camera(self) -> CameraConfig:
+        return self.renderer.camera
+
+    def set_layout(self, room: Room, geometry: SceneGeometry, layout: int) -> None:
+        """Load a layout: moves the renderer's nodes (rebuilds only for a new room)."""
+        if self._room is not None and self._room.room_id == room.room_id:
+            self.renderer.update_poses(geometry)
+        else:
+            self.renderer.load(geometry)
+        self._room, self._layout = room, int(layout)
+        self._table = ObjectTable.from_scene(geometry, room)
+
+    def view(self, pose: ViewPose, *, seed: int = 0, jitter_lights: bool = False) -> ViewRecord:
+        """Render and annotate one view of the current layout.
+
+        ``seed`` is stored in the record; with ``jitter_lights`` it also drives the light
+        jitter, so the record can be re-rendered exactly.
+        """
+        if self._table is None or self._room is None:
+            raise RenderError("no layout loaded: call ViewAnnotator.set_layout first")
+        table, cam = self._table, self.camera
+        rng = np.random.default_rng(seed) if jitter_lights else None
+        rendered = self.renderer.render(pose.x, pose.y, pose.theta, rng=rng)
+        ann = annotate(rendered, table, min_visible_pixels=self.min_visible_pixels)
+        rows = ann.rows
+        classes = [table.class_name[r] for r in rows]
+        assignment = self.slots.assign(list(zip(ann.instance.tolist(), classes, strict=True)))
+        keep = assignment.slots >= 0
+        if not keep.all():
+            rows, classes = rows[keep], [c for c, k in zip(classes, keep, strict=True) if k]
+        box2d = ann.box2d[keep] if not keep.all() else ann.box2d
+        visible = ann.visible_pixels[keep] if not keep.all() else ann.visible_pixels
+        lo, hi, sup = table.aabb_min[rows], table.aabb_max[rows], table.support[rows]
+        inst = table.instance[rows]
+        rel = compute_relations(inst, lo, hi, sup, rules=self.rules)
+        return ViewRecord(
+            room_id=self._room.room_id,
+            layout=self._layout,
+            seed=int(seed),
+            x=float(pose.x),
+            y=float(pose.y),
+            theta=float(pose.theta),
+            grid_i=int(pose.grid_i),
+            grid_j=int(pose.grid_j),
+            heading=int(pose.heading),
+            image_width=cam.width,
+            image_height=cam.height,
+            hfov_deg=cam.hfov_deg,
+            eye_height=cam.eye_height,
+            pitch_deg=cam.pitch_deg,
+            rgb=rendered.rgb,
+            obj_instance=inst,
+            obj_class=classes,
+            obj_slot=assignment.slots[keep],
+            obj_dynamics=[table.dynamics[r] for r in rows],
+            obj_box2d=box2d,
+            obj_visible_pixels=visible,
+            obj_box3d_min=lo,
+            obj_box3d_max=hi,
+            obj_obb=table.obb[rows],
+            obj_support=sup,
+            rel_src=rel.src,
+            rel_dst=rel.dst,
+            rel_type=rel.type,
+            dropped_objects=assignment.dropped,
+            depth=rendered.depth if self.keep_depth else None,
+        )

@@ -1,0 +1,253 @@
+"""Generation config: TOML files and presets mapped one to one onto frozen dataclasses.
+
+Each TOML table is one dataclass: ``[dataset]`` -> :class:`DatasetConfig`, ``[rooms]`` ->
+:class:`RoomsConfig`, ``[dynamics]`` -> :class:`sgdata.world.dynamics.DynamicsConfig`, ``[camera]``
+-> :class:`sgdata.render.camera.CameraConfig`, and so on. Unknown keys and wrong types are refused
+with the file and key path in the message; every dataclass validates its own values.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import tomllib
+import types
+import typing
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from sgdata.annotate.relations import RelationRules
+from sgdata.dataset.paths import SPLITS
+from sgdata.errors import ConfigError, SgdataError
+from sgdata.render.camera import CameraConfig
+from sgdata.world.dynamics import DynamicsConfig
+from sgdata.world.poses import PosesConfig
+from sgdata.world.room_recipes import ROOM_TYPES
+from sgdata.world.triplets import DEFAULT_SHARES, check_shares
+
+__all__ = [
+    "PRESETS",
+    "AnnotationConfig",
+    "DatasetConfig",
+    "GenerateConfig",
+    "ImagesConfig",
+    "LayoutsConfig",
+    "PosesConfig",
+    "RoomsConfig",
+    "TripletsConfig",
+    "config_to_dict",
+    "load_config",
+]
+
+PRESETS = ("tiny", "small", "paper")
+
+
+@dataclass(frozen=True)
+class DatasetConfig:
+    """Identity of the dataset and the seed every random draw derives from."""
+
+    name: str = "sgdata"
+    version: str = "0.1.0"  # the dataset's own version (not the format's)
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        if not self.name or any(c in self.name for c in "/\\ "):
+            raise ConfigError(
+                f"dataset.name {self.name!r}: expected a non-empty name without spaces or slashes"
+            )
+        if not 0 <= self.seed < 2**63:
+            raise ConfigError(f"dataset.seed must be within [0, 2**63), got {self.seed}")
+
+
+@dataclass(frozen=True)
+class RoomsConfig:
+    """Which rooms, and how many of each type go to each split (paper: 21 / 4 / 5)."""
+
+    types: tuple[str, ...] = ROOM_TYPES
+    train: int = 21
+    val: int = 4
+    test: int = 5
+
+    def __post_init__(self) -> None:
+        unknown = [t for t in self.types if t not in ROOM_TYPES]
+        if unknown or not self.types:
+            raise ConfigError(
+                f"rooms.types {list(self.types)}: expected some of {list(ROOM_TYPES)}"
+            )
+        for split in SPLITS:
+            if getattr(self, split) < 0:
+                raise ConfigError(f"rooms.{split} must be >= 0")
+        if self.train + self.val + self.test < 1:
+            raise ConfigError("rooms: train + val + test must be at least 1")
+
+    def per_split(self) -> dict[str, int]:
+        """Rooms per type in each split."""
+        return {s: getattr(self, s) for s in SPLITS}
+
+
+@dataclass(frozen=True)
+class LayoutsConfig:
+    """How many layouts each room gets (layout 0 is the base arrangement)."""
+
+    count: int = 5  # the authors' code used 5
+
+    def __post_init__(self) -> None:
+        if self.count < 2:
+            raise ConfigError(
+                f"layouts.count must be >= 2 (tier 0 needs another layout), got {self.count}"
+            )
+
+
+@dataclass(frozen=True)
+class AnnotationConfig:
+    """What counts as visible, and the relation rules."""
+
+    min_visible_pixels: int = 20
+    relations: RelationRules = field(default_factory=RelationRules)
+
+    def __post_init__(self) -> None:
+        if self.min_visible_pixels < 1:
+            raise ConfigError(
+                f"annotation.min_visible_pixels must be >= 1, got {self.min_visible_pixels}"
+            )
+
+
+@dataclass(frozen=True)
+class TripletsConfig:
+    """Triplets per split and the cascaded tier shares (paper Table I)."""
+
+    train: int = 6650
+    val: int = 1425
+    test: int = 1425
+    shares: tuple[float, ...] = DEFAULT_SHARES
+
+    def __post_init__(self) -> None:
+        for split in SPLITS:
+            if getattr(self, split) < 0:
+                raise ConfigError(f"triplets.{split} must be >= 0")
+        check_shares(self.shares)
+
+    def per_split(self) -> dict[str, int]:
+        """Triplets in each split."""
+        return {s: getattr(self, s) for s in SPLITS}
+
+
+@dataclass(frozen=True)
+class ImagesConfig:
+    """How images are encoded in the observation rows."""
+
+    format: str = "png"  # png (lossless, default) | jpeg
+    jpeg_quality: int = 92
+
+    def __post_init__(self) -> None:
+        if self.format not in ("png", "jpeg"):
+            raise ConfigError(f"images.format {self.format!r}: expected 'png' or 'jpeg'")
+        if not 1 <= self.jpeg_quality <= 100:
+            raise ConfigError(
+                f"images.jpeg_quality must be within [1, 100], got {self.jpeg_quality}"
+            )
+
+
+@dataclass(frozen=True)
+class GenerateConfig:
+    """Everything ``sgdata generate`` needs; the resolved form goes into the manifest."""
+
+    dataset: DatasetConfig = field(default_factory=DatasetConfig)
+    rooms: RoomsConfig = field(default_factory=RoomsConfig)
+    layouts: LayoutsConfig = field(default_factory=LayoutsConfig)
+    dynamics: DynamicsConfig = field(default_factory=DynamicsConfig)
+    poses: PosesConfig = field(default_factory=PosesConfig)
+    camera: CameraConfig = field(default_factory=CameraConfig)
+    annotation: AnnotationConfig = field(default_factory=AnnotationConfig)
+    triplets: TripletsConfig = field(default_factory=TripletsConfig)
+    images: ImagesConfig = field(default_factory=ImagesConfig)
+
+
+def load_config(source: str | Path) -> GenerateConfig:
+    """A config from a TOML file, or from a preset name (``tiny``, ``small``, ``paper``).
+
+    Raises:
+        ConfigError: unknown preset, unreadable or malformed TOML, unknown key, wrong type or
+            out-of-range value — naming the file and the key.
+    """
+    text, where = _read(source)
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(f"{where}: not valid TOML ({exc})") from None
+    try:
+        return _build(GenerateConfig, data, "")
+    except ConfigError as exc:
+        raise ConfigError(f"{where}: {exc}") from None
+
+
+def config_to_dict(config: Any) -> Any:
+    """Plain JSON-able form of a config (tuples become lists), for the manifest."""
+    if dataclasses.is_dataclass(config):
+        return {f.name: config_to_dict(getattr(config, f.name)) for f in dataclasses.fields(config)}
+    if isinstance(config, dict):
+        return {str(k): config_to_dict(v) for k, v in config.items()}
+    if isinstance(config, tuple | list):
+        return [config_to_dict(v) for v in config]
+    return config
+
+
+def _read(source: str | Path) -> tuple[str, str]:
+    if isinstance(source, str) and source in PRESETS:
+        preset = resources.files("sgdata_configs").joinpath(f"{source}.toml")
+        return preset.read_text(encoding="utf-8"), f"preset {source}"
+    path = Path(source)
+    if not path.is_file():
+        raise ConfigError(
+            f"{path}: no such config file (or preset: expected one of {', '.join(PRESETS)})"
+        )
+    return path.read_text(encoding="utf-8"), str(path)
+
+
+def _build(cls: type, data: Any, prefix: str) -> Any:
+    """Instantiate dataclass ``cls`` from a TOML table, recursively, checking keys and types."""
+    if not isinstance(data, dict):
+        raise ConfigError(f"{prefix or 'config'}: expected a table")
+    hints = typing.get_type_hints(cls)
+    names = {f.name for f in dataclasses.fields(cls)}
+    unknown = sorted(set(data) - names)
+    if unknown:
+        key = f"{prefix}{unknown[0]}"
+        raise ConfigError(f"unknown key {key!r}; known keys here: {', '.join(sorted(names))}")
+    kwargs = {name: _convert(hints[name], value, f"{prefix}{name}") for name, value in data.items()}
+    try:
+        return cls(**kwargs)
+    except SgdataError as exc:  # sections validate themselves (a camera raises RenderError)
+        raise ConfigError(str(exc)) from None
+    except TypeError as exc:
+        raise ConfigError(f"{prefix.rstrip('.') or 'config'}: {exc}") from None
+
+
+def _convert(hint: Any, value: Any, key: str) -> Any:
+    if dataclasses.is_dataclass(hint):
+        return _build(hint, value, f"{key}.")
+    origin = typing.get_origin(hint)
+    args = typing.get_args(hint)
+    if origin is tuple:
+        if not isinstance(value, list):
+            raise ConfigError(f"key {key!r}: expected a list, got {value!r}")
+        item = args[0] if args else Any
+        return tuple(_convert(item, v, f"{key}[{i}]") for i, v in enumerate(value))
+    if origin is dict:
+        if not isinstance(value, dict):
+            raise ConfigError(f"key {key!r}: expected a table, got {value!r}")
+        return {k: _convert(args[1], v, f"{key}.{k}") for k, v in value.items()}
+    if origin in (typing.Union, types.UnionType):
+        if value is None:
+            return None
+        return _convert(next(a for a in args if a is not type(None)), value, key)
+    if hint is float:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise ConfigError(f"key {key!r}: expected a number, got {value!r}")
+        return float(value)
+    if hint is int or hint is bool or hint is str:
+        if type(value) is not hint:
+            raise ConfigError(f"key {key!r}: expected {hint.__name__}, got {value!r}")
+        return value
+    return value

@@ -1,0 +1,255 @@
+"""``sgdata generate``: a config in, a versioned Parquet triplet dataset out.
+
+Three phases, each recorded in a ledger under ``<root>/.sgdata/`` so an interrupted run
+resumes without redoing finished work:
+
+1. scenes (per room, in the pool): room + layouts as USD, reachable pose grid per layout;
+2. triplets (per split, in this process): cascaded triplets over the split's rooms, which
+   fixes exactly which views must be rendered;
+3. views (per room, in the pool, one renderer per worker): render and annotate the
+   referenced views, write ``observations/<split>/<room>.parquet`` atomically.
+
+Then the triplet tables and, last, ``dataset.json``. Every random draw derives from the
+config seed and the room / layout / view keys, so the bytes do not depend on the worker count.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from sgdata.dataset.paths import MANIFEST, OUTPUTS, SPLITS, scene_dir
+from sgdata.errors import ConfigError
+from sgdata.fileio import atomic_write_text, prepare_output_dir, remove_stale_temps
+from sgdata.pipeline.config import GenerateConfig, config_to_dict
+from sgdata.pipeline.executors import run_tasks
+from sgdata.pipeline.ledger import (
+    CONFIG_RECORD,
+    LEDGER,
+    read_record,
+    scene_record,
+    views_record,
+)
+from sgdata.pipeline.room_tasks import RoomTask
+from sgdata.seeds import split_triplets_seed
+from sgdata.world.room_recipes import ROOM_TYPES
+from sgdata.world.triplets import RoomPoses, Triplet, referenced_poses_by_room, sample_triplets
+
+__all__ = ["GenerateProgress", "generate_dataset", "plan_rooms"]
+
+
+@dataclass(frozen=True)
+class GenerateProgress:
+    """What a progress callback is told after each finished room of a phase."""
+
+    phase: str  # "scenes" | "views"
+    done: int
+    total: int
+    views: int  # views rendered so far in this run
+    elapsed: float  # seconds since the phase started
+
+
+def plan_rooms(config: GenerateConfig) -> list[RoomTask]:
+    """Rooms of every type, numbered per type: train first, then val, then test."""
+    tasks = []
+    for room_type in ROOM_TYPES:
+        if room_type not in config.rooms.types:
+            continue
+        index = 0
+        for split, count in config.rooms.per_split().items():
+            for _ in range(count):
+                tasks.append(RoomTask(room_type, index, split))
+                index += 1
+    return tasks
+
+
+def generate_dataset(
+    config: GenerateConfig,
+    root: Path,
+    *,
+    workers: int = 1,
+    resume: bool = False,
+    force: bool = False,
+    progress: Callable[[GenerateProgress], None] | None = None,
+) -> dict:
+    """Generate the dataset described by ``config`` into ``root``; returns the manifest dict.
+
+    Raises:
+        ConfigError: ``root`` is a file, holds a finished dataset (without ``force``), holds
+            an unfinished run (without ``resume`` or ``force``), or was started with another
+            config (on ``resume``).
+        DatasetError: a file cannot be written (the run can be resumed once fixed).
+    """
+    if workers < 1:
+        raise ConfigError(f"--workers must be >= 1, got {workers}")
+    _prepare_root(root, config, resume=resume, force=force)
+    tasks = plan_rooms(config)
+    scene_jobs = [t for t in tasks if not scene_record(root, t.room_id).exists()]
+    _run_phase("scenes", scene_jobs, len(tasks), config, root, workers, progress)
+    grids = {t.room_id: read_record(scene_record(root, t.room_id)) for t in tasks}
+
+    triplets = {split: _split_triplets(config, split, tasks, grids) for split in SPLITS}
+    poses = referenced_poses_by_room(t for split in SPLITS for t in triplets[split])
+    view_jobs = [
+        (t, poses.get(t.room_id, [])) for t in tasks if not views_record(root, t.room_id).exists()
+    ]
+    _run_phase("views", view_jobs, len(tasks), config, root, workers, progress)
+
+    shards = [read_record(views_record(root, t.room_id)) for t in tasks]
+    return _finish(root, config, tasks, shards, triplets)
+
+
+def _finish(
+    root: Path,
+    config: GenerateConfig,
+    tasks: list[RoomTask],
+    shards: list[dict],
+    triplets: dict[str, list[Triplet]],
+) -> dict:
+    """Write the triplet tables, then the manifest (last: its presence means finished)."""
+    from sgdata import __version__
+    from sgdata.dataset.manifest import (
+        Counts,
+        FileEntry,
+        Generator,
+        ImageInfo,
+        Manifest,
+        file_entry,
+        write_manifest,
+    )
+    from sgdata.dataset.paths import obs_id, triplets_path
+    from sgdata.dataset.rows import triplet_table, write_parquet
+    from sgdata.dataset.vocabulary import class_vocabulary
+
+    splits = [s for s in SPLITS if any(t.split == s for t in tasks)]
+    files = [FileEntry(r["path"], r["rows"], r["sha256"], r["bytes"]) for r in shards]
+    for split in splits:
+        ids = {
+            obs_id(t.room_id, k.layout, k.i, k.j, k.heading)
+            for t in triplets[split]
+            for k in (t.anchor, t.positive, t.negative)
+        }
+        relative = triplets_path(split)
+        info = write_parquet(triplet_table(triplets[split], ids), root / relative)
+        files.append(FileEntry(relative, info.rows, info.sha256, info.bytes))
+    for task in tasks:
+        for usd in sorted(scene_dir(root, task.room_id).glob("*.usda")):
+            files.append(file_entry(root, usd.relative_to(root).as_posix(), rows=None))
+    slots, classes = class_vocabulary()
+    manifest = Manifest(
+        name=config.dataset.name,
+        version=config.dataset.version,
+        generator=Generator("sgdata", __version__),
+        seed=config.dataset.seed,
+        config=config_to_dict(config),
+        classes=classes,
+        num_slots=slots.num_slots,
+        relation_rules=config.annotation.relations.to_dict(),
+        image=ImageInfo(config.images.format, config.camera.width, config.camera.height),
+        splits={s: tuple(t.room_id for t in tasks if t.split == s) for s in splits},
+        counts=Counts(
+            rooms=len(tasks),
+            observations={
+                s: sum(r["rows"] for r, t in zip(shards, tasks, strict=True) if t.split == s)
+                for s in splits
+            },
+            triplets={s: len(triplets[s]) for s in splits},
+            tiers={s: [sum(t.tier == k for t in triplets[s]) for k in range(5)] for s in splits},
+        ),
+        files=tuple(sorted(files, key=lambda f: f.path)),
+    )
+    write_manifest(manifest, root)
+    return manifest.to_dict()
+
+
+def _prepare_root(root: Path, config: GenerateConfig, *, resume: bool, force: bool) -> None:
+    if root.exists() and not root.is_dir():
+        raise ConfigError(f"{root}: is a file; expected a directory for the dataset")
+    ledger = root / LEDGER
+    if (root / MANIFEST).exists() and not force:
+        raise ConfigError(f"{root}: holds a finished dataset; pass --force to overwrite it")
+    if ledger.exists() and not (resume or force):
+        raise ConfigError(
+            f"{root}: holds an unfinished generation; pass --resume to continue it "
+            "or --force to start over"
+        )
+    if force:
+        _remove_outputs(root)
+    prepare_output_dir(root)
+    remove_stale_temps(root)  # a killed run may have left half-written temporaries
+    record = ledger / CONFIG_RECORD
+    wanted = json.dumps(config_to_dict(config), sort_keys=True, indent=2)
+    if record.exists():
+        if record.read_text(encoding="utf-8") != wanted:
+            raise ConfigError(
+                f"{root}: was started with another config; rerun with that config "
+                "or pass --force to start over"
+            )
+    else:
+        ledger.mkdir(parents=True, exist_ok=True)
+        atomic_write_text(record, wanted)
+
+
+def _remove_outputs(root: Path) -> None:
+    """Delete what a generation writes (and nothing else the user may keep there)."""
+    for name in (*OUTPUTS, LEDGER):
+        target = root / name
+        if target.is_dir():
+            shutil.rmtree(target)
+        elif target.exists():
+            target.unlink()
+
+
+def _run_phase(
+    phase: str,
+    jobs: list,
+    total: int,
+    config: GenerateConfig,
+    root: Path,
+    workers: int,
+    progress: Callable[[GenerateProgress], None] | None,
+) -> None:
+    from sgdata.pipeline.room_tasks import render_room_views, write_room_scenes
+
+    start = time.perf_counter()
+    done = total - len(jobs)
+    views = 0
+    if phase == "scenes":
+        payloads = [(task, config, root) for task in jobs]
+        fn = write_room_scenes
+    else:
+        payloads = [(task, list(poses), config, root) for task, poses in jobs]
+        fn = render_room_views
+    for result in run_tasks(fn, payloads, workers=workers):
+        done += 1
+        views += int(result.get("views", 0))
+        if progress is not None:
+            progress(GenerateProgress(phase, done, total, views, time.perf_counter() - start))
+
+
+def _split_triplets(
+    config: GenerateConfig, split: str, tasks: list[RoomTask], grids: dict[str, dict]
+) -> list[Triplet]:
+    total = config.triplets.per_split()[split]
+    rooms = [
+        RoomPoses(
+            t.room_id,
+            split,
+            {
+                int(k): frozenset(tuple(c) for c in cells)
+                for k, cells in grids[t.room_id]["reachable"].items()
+            },
+        )
+        for t in tasks
+        if t.split == split
+    ]
+    if total == 0:
+        return []
+    if not rooms:
+        raise ConfigError(f"triplets.{split} = {total} but rooms.{split} = 0: no room to draw from")
+    seed = split_triplets_seed(config.dataset.seed, SPLITS.index(split))
+    return sample_triplets(rooms, total, seed, shares=config.triplets.shares)

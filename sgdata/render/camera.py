@@ -1,0 +1,85 @@
+"""The pinhole camera the agent carries: intrinsics, pose and projection (no backend imports)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from sgdata.errors import RenderError
+
+__all__ = ["CameraConfig"]
+
+
+@dataclass(frozen=True)
+class CameraConfig:
+    """A pinhole camera carried by the agent, level in roll, pitched down by ``pitch_deg``.
+
+    Pixel coordinates are continuous: pixel (u, v) (column u, row v, row 0 at the top) covers
+    [u, u + 1) x [v, v + 1) and its centre is (u + 0.5, v + 0.5).
+    """
+
+    width: int = 224  # pixels (SeanNet input size)
+    height: int = 224  # pixels
+    hfov_deg: float = 90.0  # horizontal field of view; AI2-THOR's default is 90
+    eye_height: float = 1.5  # camera height above the floor (m), about AI2-THOR's agent eye
+    # Positive looks down. 20 deg keeps the far wall's paintings and windows in view while
+    # bringing table tops, counters and the near floor (where small objects lie) into the
+    # lower half: at 0 deg a 224 px image spends its lower ~30% on bare floor.
+    pitch_deg: float = 20.0
+    znear: float = 0.05  # near clip plane (m)
+    zfar: float = 30.0  # far clip plane (m)
+
+    def __post_init__(self) -> None:
+        if self.width < 1 or self.height < 1:
+            raise RenderError(f"camera size {self.width}x{self.height}: expected >= 1 pixel each")
+        if not 0.0 < self.hfov_deg < 180.0:
+            raise RenderError(f"camera hfov_deg={self.hfov_deg}: expected in (0, 180)")
+        if not -90.0 < self.pitch_deg < 90.0:
+            raise RenderError(f"camera pitch_deg={self.pitch_deg}: expected in (-90, 90)")
+        if not 0.0 < self.znear < self.zfar:
+            raise RenderError(f"camera znear={self.znear}, zfar={self.zfar}: need 0 < znear < zfar")
+
+    @property
+    def focal(self) -> float:
+        """Focal length in pixels (square pixels: fx = fy)."""
+        return (self.width / 2.0) / math.tan(math.radians(self.hfov_deg) / 2.0)
+
+    @property
+    def yfov(self) -> float:
+        """Vertical field of view in radians."""
+        return 2.0 * math.atan((self.height / 2.0) / self.focal)
+
+    def intrinsics(self) -> np.ndarray:
+        """3x3 K mapping camera (right, down, forward) coordinates to continuous pixels."""
+        f = self.focal
+        return np.array([[f, 0.0, self.width / 2.0], [0.0, f, self.height / 2.0], [0, 0, 1.0]])
+
+    def basis(self, theta: float) -> np.ndarray:
+        """Rows right, up, forward (world unit vectors) for heading ``theta`` (rad about +Z)."""
+        p = math.radians(self.pitch_deg)
+        ct, st, cp, sp = math.cos(theta), math.sin(theta), math.cos(p), math.sin(p)
+        forward = np.array([ct * cp, st * cp, -sp])
+        right = np.array([st, -ct, 0.0])
+        up = np.cross(right, forward)
+        return np.stack([right, up, forward])
+
+    def pose_matrix(self, x: float, y: float, theta: float) -> np.ndarray:
+        """4x4 camera-to-world transform in OpenGL convention (camera looks along -Z, +Y up)."""
+        right, up, forward = self.basis(theta)
+        m = np.eye(4)
+        m[:3, 0], m[:3, 1], m[:3, 2] = right, up, -forward
+        m[:3, 3] = (x, y, self.eye_height)
+        return m
+
+    def project(self, points: np.ndarray, x: float, y: float, theta: float) -> np.ndarray:
+        """World points (N, 3) -> (N, 3) of continuous pixel u, v and forward depth (m)."""
+        rel = np.asarray(points, dtype=np.float64) - (x, y, self.eye_height)
+        right, up, forward = self.basis(theta)
+        xc, yc, zc = rel @ right, rel @ up, rel @ forward
+        f = self.focal
+        with np.errstate(divide="ignore", invalid="ignore"):
+            u = self.width / 2.0 + f * xc / zc
+            v = self.height / 2.0 - f * yc / zc
+        return np.stack([u, v, zc], axis=1)

@@ -1,0 +1,165 @@
+"""Reading a composed stage's meshes for rendering, from pxr alone (no catalog needed).
+
+Any stage whose object prims carry ``sgdata:instance`` renders, whatever tool wrote it: a prim
+with that attribute is an object, every mesh beneath it is part of that object (expressed in
+the object's local frame), and every other mesh is structure (in world space). Faces with more
+than three corners are fanned into triangles; ``primvars:displayColor`` gives the face colours
+(constant, uniform, vertex and faceVarying interpolation; grey when absent).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from pxr import Usd, UsdGeom
+
+from sgdata.errors import UsdError
+from sgdata.usd.meshes import MeshData, ObjectGeometry, SceneGeometry, merge_meshes
+from sgdata.usd.room_io import open_stage
+from sgdata.world.scene import transform_points
+
+__all__ = ["DEFAULT_COLOR", "read_geometry"]
+
+DEFAULT_COLOR = (0.6, 0.6, 0.6)  # face colour of meshes without a displayColor
+
+
+def read_geometry(path: Path) -> SceneGeometry:
+    """The triangle meshes of the composed stage at ``path`` (a room, a layout, any USD file).
+
+    Invisible prims and guide/proxy purposes are skipped; instance proxies are followed.
+
+    Raises:
+        UsdError: the file is missing, unreadable or does not compose, or an object prim has
+            a non-integer or duplicate ``sgdata:instance``.
+    """
+    path = Path(path)
+    stage = open_stage(path)
+    cache = UsdGeom.XformCache(Usd.TimeCode.Default())
+    owners: dict[str, Usd.Prim] = {}  # object prim path -> prim, in traversal order
+    parts: dict[str, list[MeshData]] = {}
+    structure = []
+    prims = iter(Usd.PrimRange.Stage(stage, Usd.TraverseInstanceProxies()))
+    for prim in prims:
+        if not _drawn(prim):
+            prims.PruneChildren()  # type: ignore[attr-defined]
+            continue
+        if prim.HasAttribute("sgdata:instance"):
+            owners[str(prim.GetPath())] = prim
+            parts.setdefault(str(prim.GetPath()), [])
+        if not prim.IsA(UsdGeom.Mesh):
+            continue
+        vertices, faces, colors = _triangles(UsdGeom.Mesh(prim))
+        world = _world(cache, prim)
+        owner = _owner(prim, owners)
+        if owner is None:
+            structure.append(
+                MeshData(transform_points(world, vertices), faces, colors, str(prim.GetPath()))
+            )
+        else:
+            to_owner = np.linalg.inv(_world(cache, owner)) @ world
+            parts[str(owner.GetPath())].append(
+                MeshData(transform_points(to_owner, vertices), faces, colors)
+            )
+    objects = []
+    seen: dict[int, str] = {}
+    for key, prim in owners.items():
+        instance = prim.GetAttribute("sgdata:instance").Get()
+        if not isinstance(instance, int) or isinstance(instance, bool):
+            raise UsdError(f"{path}: {key} sgdata:instance is {instance!r}; expected an integer")
+        if instance in seen:
+            raise UsdError(f"{path}: {key} and {seen[instance]} share sgdata:instance {instance}")
+        seen[instance] = key
+        cls = prim.GetAttribute("sgdata:class").Get() if prim.HasAttribute("sgdata:class") else None
+        objects.append(
+            ObjectGeometry(
+                instance=instance,
+                class_name=str(cls) if cls else prim.GetName(),
+                mesh=merge_meshes(parts[key], key),
+                matrix=_world(cache, prim),
+            )
+        )
+    return SceneGeometry(structure=tuple(structure), objects=tuple(objects))
+
+
+def _drawn(prim: Usd.Prim) -> bool:
+    if not prim.IsA(UsdGeom.Imageable):
+        return True
+    imageable = UsdGeom.Imageable(prim)
+    if imageable.GetVisibilityAttr().Get() == UsdGeom.Tokens.invisible:
+        return False
+    return imageable.GetPurposeAttr().Get() not in (UsdGeom.Tokens.guide, UsdGeom.Tokens.proxy)
+
+
+def _owner(prim: Usd.Prim, owners: dict[str, Usd.Prim]) -> Usd.Prim | None:
+    """The nearest object prim at or above ``prim`` (ancestors come first in traversal)."""
+    for path in reversed(prim.GetPath().GetPrefixes()):
+        if str(path) in owners:
+            return owners[str(path)]
+    return None
+
+
+def _world(cache: UsdGeom.XformCache, prim: Usd.Prim) -> np.ndarray:
+    # USD matrices act on row vectors (p' = p M): transpose for the column convention
+    return np.array(cache.GetLocalToWorldTransform(prim), dtype=np.float64).T
+
+
+def _triangles(mesh: UsdGeom.Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Fan-triangulate a mesh; colours per triangle from its displayColor primvar."""
+    points = mesh.GetPointsAttr().Get()
+    counts = mesh.GetFaceVertexCountsAttr().Get()
+    indices = mesh.GetFaceVertexIndicesAttr().Get()
+    vertices = np.array(points, dtype=np.float64).reshape(-1, 3) if points else np.zeros((0, 3))
+    counts = np.array(counts, dtype=np.int64) if counts else np.zeros(0, np.int64)
+    indices = np.array(indices, dtype=np.int64) if indices else np.zeros(0, np.int64)
+    if counts.sum() != len(indices) or (len(indices) and indices.max() >= len(vertices)):
+        return np.zeros((0, 3)), np.zeros((0, 3), np.int32), np.zeros((0, 3), np.float32)
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
+    tri_counts = np.maximum(counts - 2, 0)
+    face_of = np.repeat(np.arange(len(counts)), tri_counts)  # source face of each triangle
+    k = np.arange(len(face_of)) - np.repeat(np.cumsum(tri_counts) - tri_counts, tri_counts)
+    corners = np.stack([starts[face_of], starts[face_of] + k + 1, starts[face_of] + k + 2], 1)
+    if mesh.GetOrientationAttr().Get() == UsdGeom.Tokens.leftHanded:
+        corners = corners[:, [0, 2, 1]]
+    faces = indices[corners].astype(np.int32)
+    colors = _face_colors(mesh, counts)[face_of]
+    if len(corners):
+        corner_colors = _corner_colors(mesh, indices, len(vertices))
+        if corner_colors is not None:  # per-vertex / face-varying: average over the triangle
+            colors = corner_colors[corners].mean(axis=1).astype(np.float32)
+    return vertices, faces, colors
+
+
+def _display_color(mesh: UsdGeom.Mesh) -> tuple[np.ndarray, str] | None:
+    primvar = UsdGeom.PrimvarsAPI(mesh.GetPrim()).GetPrimvar("displayColor")
+    if not primvar or not primvar.HasValue():
+        return None
+    values = primvar.ComputeFlattened()
+    if values is None or len(values) == 0:
+        return None
+    return np.array(values, dtype=np.float32).reshape(-1, 3), primvar.GetInterpolation()
+
+
+def _face_colors(mesh: UsdGeom.Mesh, counts: np.ndarray) -> np.ndarray:
+    found = _display_color(mesh)
+    n = len(counts)
+    if found is not None:
+        values, interpolation = found
+        if interpolation == UsdGeom.Tokens.uniform and len(values) == n:
+            return values
+        if interpolation == UsdGeom.Tokens.constant:
+            return np.tile(values[0], (n, 1))
+    return np.tile(np.asarray(DEFAULT_COLOR, np.float32), (n, 1))
+
+
+def _corner_colors(mesh: UsdGeom.Mesh, indices: np.ndarray, n_points: int) -> np.ndarray | None:
+    """Colour of every face-vertex corner for vertex / faceVarying colours, else ``None``."""
+    found = _display_color(mesh)
+    if found is None:
+        return None
+    values, interpolation = found
+    if interpolation in (UsdGeom.Tokens.vertex, UsdGeom.Tokens.varying) and len(values) == n_points:
+        return values[indices]
+    if interpolation == UsdGeom.Tokens.faceVarying and len(values) == len(indices):
+        return values
+    return None

@@ -1,0 +1,505 @@
+"""Writing and reading rooms as USD stages (``room.usda``) and checking them with USD's validators.
+
+Layout of a room stage (the on-disk contract; layouts in :mod:`sgdata.usd.layout_layers`
+override it)::
+
+    /Room                      Xform, kind assembly; sgdata:roomId, roomType, seed, roomSize
+                               (width, depth, height), door:wall, door:center, door:width, door:top
+    /Room/Structure            Xform; Meshes Floor, Ceiling, Walls (door gap cut out)
+    /Room/Objects              Xform, kind group
+    /Room/Objects/<Class>_<instance:04d>
+                               Xform, kind component; xformOp:translate (double3) then
+                               xformOp:rotateZ (double, degrees); sgdata:class, dynamics,
+                               instance, size (float3), variant, color (color3f); rel
+                               sgdata:support and sgdata:attachedTo (only when set)
+    /Room/Objects/<prim>/Geom  Mesh in the object's local frame, triangles, uniform displayColor
+
+A door's ``center`` is measured along its wall from the wall's low-coordinate end: from x = 0
+on the south and north walls, from y = 0 on the east and west walls. ``sgdata:size`` and
+``sgdata:color`` are float32 (as the contract says), so they read back as the shortest decimal
+of their float32 value: sizes and colours with at most 6 significant digits round-trip exactly.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from functools import cache
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+from pxr import Gf, Kind, Sdf, Tf, Usd, UsdGeom, UsdValidation, Vt
+
+from sgdata.errors import SceneError, UsdError
+from sgdata.fileio import atomic_write_text
+from sgdata.world.scene import WALLS, Dynamics, Opening, Placement, Room, SceneObject
+
+if TYPE_CHECKING:
+    from sgdata.world.catalog import Catalog
+
+__all__ = [
+    "ROOT",
+    "OBJECTS",
+    "STRUCTURE",
+    "Geometry",
+    "catalog_geometry",
+    "write_room",
+    "read_room",
+    "object_path",
+    "open_layer",
+    "open_stage",
+    "write_text_atomic",
+    "validate_stage",
+    "check_stage",
+]
+
+ROOT = Sdf.Path("/Room")
+OBJECTS = ROOT.AppendChild("Objects")
+STRUCTURE = ROOT.AppendChild("Structure")
+WALL_THICKNESS = 0.1  # metres, outside the room rectangle
+SLAB_THICKNESS = 0.1  # floor below z = 0, ceiling above z = height
+
+# (vertices (V, 3), faces (F, 3), face colours (F, 3)) of one object, in its local frame.
+Geometry = Callable[[SceneObject], tuple[np.ndarray, np.ndarray, np.ndarray]]
+
+_WALL_COLOR = (0.86, 0.84, 0.80)
+_CEILING_COLOR = (0.93, 0.93, 0.91)
+_FLOOR_COLORS = {  # tiles in wet rooms, wood elsewhere
+    "kitchen": (0.62, 0.62, 0.60),
+    "bathroom": (0.80, 0.84, 0.86),
+    "living_room": (0.55, 0.38, 0.24),
+    "bedroom": (0.60, 0.44, 0.30),
+}
+_DEFAULT_FLOOR = (0.5, 0.5, 0.5)
+
+_STR, _TOKEN, _INT, _INT64 = (
+    Sdf.ValueTypeNames.String,
+    Sdf.ValueTypeNames.Token,
+    Sdf.ValueTypeNames.Int,
+    Sdf.ValueTypeNames.Int64,
+)
+_DOUBLE, _DOUBLE3 = Sdf.ValueTypeNames.Double, Sdf.ValueTypeNames.Double3
+_FLOAT3, _COLOR3F = Sdf.ValueTypeNames.Float3, Sdf.ValueTypeNames.Color3f
+
+
+def catalog_geometry(catalog: Catalog | None = None) -> Geometry:
+    """The default geometry source: each object's catalog recipe, merged into one mesh.
+
+    Args:
+        catalog: the catalog naming each class's recipe; the shipped one when ``None``.
+    """
+    from sgdata.world.catalog import load_catalog  # late: the catalog and recipes pull in trimesh
+    from sgdata.world.shapes import build_shape, merged_mesh
+
+    cat = catalog if catalog is not None else load_catalog()
+
+    def geometry(obj: SceneObject) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        spec = cat[obj.class_name]
+        return merged_mesh(build_shape(spec.shape, obj.size, obj.variant, obj.color))
+
+    return geometry
+
+
+# ---------------------------------------------------------------------------------- writing
+
+
+def write_room(room: Room, path: Path, *, geometry: Geometry) -> None:
+    """Write ``room`` as a USD stage at ``path``, atomically and byte-reproducibly.
+
+    Args:
+        room: the room to write; its objects become prims in ``room.objects`` order.
+        path: the ``.usda`` file to write (its folder is created if missing).
+        geometry: local-frame mesh of an object (see :func:`catalog_geometry`).
+
+    Raises:
+        SceneError: an object's support or owner is not in the room, or its mesh is malformed.
+        UsdError: the file cannot be written.
+    """
+    stage = Usd.Stage.CreateInMemory()
+    UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.z)
+    UsdGeom.SetStageMetersPerUnit(stage, 1.0)
+    root = UsdGeom.Xform.Define(stage, ROOT).GetPrim()
+    stage.SetDefaultPrim(root)
+    Usd.ModelAPI(root).SetKind(Kind.Tokens.assembly)
+    _set(root, "sgdata:roomId", _STR, room.room_id)
+    _set(root, "sgdata:roomType", _TOKEN, room.room_type)
+    _set(root, "sgdata:seed", _INT64, _int64(room.seed, f"room {room.room_id} seed"))
+    _set(root, "sgdata:roomSize", _DOUBLE3, Gf.Vec3d(room.width, room.depth, room.height))
+    _set(root, "sgdata:door:wall", _TOKEN, room.door.wall)
+    _set(root, "sgdata:door:center", _DOUBLE, room.door.center)
+    _set(root, "sgdata:door:width", _DOUBLE, room.door.width)
+    _set(root, "sgdata:door:top", _DOUBLE, room.door.top)
+    if room.door.bottom != 0.0:  # a door has none; kept so other openings round-trip too
+        _set(root, "sgdata:door:bottom", _DOUBLE, room.door.bottom)
+
+    UsdGeom.Xform.Define(stage, STRUCTURE)
+    for name, (vertices, faces, colors) in _structure_meshes(room).items():
+        _define_mesh(stage, STRUCTURE.AppendChild(name), vertices, faces, colors)
+
+    group = UsdGeom.Xform.Define(stage, OBJECTS).GetPrim()
+    Usd.ModelAPI(group).SetKind(Kind.Tokens.group)
+    by_instance = room.by_instance()
+    for obj in room.objects:
+        _define_object(stage, obj, by_instance, geometry)
+    write_text_atomic(path, stage.GetRootLayer().ExportToString())
+
+
+def object_path(obj: SceneObject) -> Sdf.Path:
+    """The prim path of an object: ``/Room/Objects/<Class>_<instance:04d>``."""
+    return OBJECTS.AppendChild(obj.prim_name)
+
+
+def _define_object(
+    stage: Usd.Stage, obj: SceneObject, by_instance: dict[int, SceneObject], geometry: Geometry
+) -> None:
+    where = f"object {obj.prim_name}"
+    xform = UsdGeom.Xform.Define(stage, object_path(obj))
+    prim = xform.GetPrim()
+    Usd.ModelAPI(prim).SetKind(Kind.Tokens.component)
+    p = obj.placement
+    xform.AddTranslateOp(UsdGeom.XformOp.PrecisionDouble).Set(Gf.Vec3d(p.x, p.y, p.z))
+    xform.AddRotateZOp(UsdGeom.XformOp.PrecisionDouble).Set(math.degrees(p.yaw))
+    _set(prim, "sgdata:class", _STR, obj.class_name)
+    _set(prim, "sgdata:dynamics", _TOKEN, str(obj.dynamics))
+    _set(prim, "sgdata:instance", _INT, obj.instance)
+    _set(prim, "sgdata:size", _FLOAT3, Gf.Vec3f(*obj.size))
+    _set(prim, "sgdata:variant", _INT, obj.variant)
+    _set(prim, "sgdata:color", _COLOR3F, Gf.Vec3f(*obj.color))
+    for rel_name, target in (
+        ("sgdata:support", obj.support),
+        ("sgdata:attachedTo", obj.attached_to),
+    ):
+        if target is None:
+            continue
+        if target not in by_instance:
+            raise SceneError(f"{where}: {rel_name} names instance {target}, not in the room")
+        rel = prim.CreateRelationship(rel_name, custom=True)
+        rel.SetTargets([object_path(by_instance[target])])
+    vertices, faces, colors = _checked_mesh(where, *geometry(obj))
+    _define_mesh(stage, object_path(obj).AppendChild("Geom"), vertices, faces, colors)
+
+
+def _define_mesh(
+    stage: Usd.Stage, path: Sdf.Path, vertices: np.ndarray, faces: np.ndarray, colors: np.ndarray
+) -> None:
+    mesh = UsdGeom.Mesh.Define(stage, path)
+    points = Vt.Vec3fArray.FromNumpy(np.ascontiguousarray(vertices, dtype=np.float32))
+    mesh.CreatePointsAttr(points)
+    mesh.CreateFaceVertexCountsAttr(Vt.IntArray.FromNumpy(np.full(len(faces), 3, np.int32)))
+    mesh.CreateFaceVertexIndicesAttr(
+        Vt.IntArray.FromNumpy(np.ascontiguousarray(faces, dtype=np.int32).ravel())
+    )
+    mesh.CreateExtentAttr(UsdGeom.Mesh.ComputeExtent(points))
+    mesh.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
+    mesh.CreateDoubleSidedAttr(False)
+    primvar = mesh.CreateDisplayColorPrimvar(UsdGeom.Tokens.uniform)
+    primvar.Set(Vt.Vec3fArray.FromNumpy(np.ascontiguousarray(colors, dtype=np.float32)))
+
+
+def _checked_mesh(
+    where: str, vertices: np.ndarray, faces: np.ndarray, colors: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    v, f, c = np.asarray(vertices), np.asarray(faces), np.asarray(colors)
+    if v.ndim != 2 or v.shape[1] != 3 or f.ndim != 2 or f.shape[1] != 3 or c.shape != f.shape:
+        raise SceneError(
+            f"{where}: geometry must be vertices (V, 3), faces (F, 3), colours (F, 3); "
+            f"got {v.shape}, {f.shape}, {c.shape}"
+        )
+    if len(f) and (f.min() < 0 or f.max() >= len(v)):
+        raise SceneError(f"{where}: face indices outside [0, {len(v)})")
+    return v, f, c
+
+
+def _set(prim: Usd.Prim, name: str, type_name: Sdf.ValueTypeName, value: object) -> None:
+    prim.CreateAttribute(name, type_name, custom=True).Set(value)
+
+
+def _int64(value: int, what: str) -> int:
+    if not -(2**63) <= value < 2**63:
+        raise SceneError(f"{what} {value} does not fit USD's int64; use a seed below 2**63")
+    return int(value)
+
+
+def write_text_atomic(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` through a temporary file in the same folder and a rename.
+
+    Raises:
+        UsdError: the folder cannot be created or the file cannot be written.
+    """
+    path = Path(path)
+    try:
+        atomic_write_text(path, text)
+    except OSError as exc:
+        raise UsdError(f"{path}: cannot write USD file ({exc.strerror or exc})") from None
+    layer = Sdf.Layer.Find(str(path))
+    if layer is not None:  # a layer still open in this process would otherwise be stale
+        layer.Reload(force=True)
+
+
+def _box(lo: tuple[float, float, float], hi: tuple[float, float, float]) -> np.ndarray:
+    """The 12 outward-wound triangles of the box [lo, hi], as an (12, 3, 3) corner array."""
+    corners = np.array(
+        [
+            [(lo, hi)[i & 1][0], (lo, hi)[(i >> 1) & 1][1], (lo, hi)[(i >> 2) & 1][2]]
+            for i in range(8)
+        ]
+    )
+    tris = [[0, 2, 3], [0, 3, 1], [4, 5, 7], [4, 7, 6], [0, 1, 5], [0, 5, 4]]
+    tris += [[2, 6, 7], [2, 7, 3], [0, 4, 6], [0, 6, 2], [1, 3, 7], [1, 7, 5]]
+    return corners[np.array(tris)]
+
+
+def _wall_boxes(room: Room) -> list[np.ndarray]:
+    """The wall boxes, each wall split around the openings that lie in it."""
+    w, d, h, t = room.width, room.depth, room.height, WALL_THICKNESS
+    # wall -> (along-axis span, fixed-axis span, along axis is x)
+    spans = {
+        "south": ((-t, w + t), (-t, 0.0), True),
+        "north": ((-t, w + t), (d, d + t), True),
+        "west": ((0.0, d), (-t, 0.0), False),
+        "east": ((0.0, d), (w, w + t), False),
+    }
+    boxes = []
+    for wall in WALLS:
+        (a0, a1), (b0, b1), along_x = spans[wall]
+        pieces = [(a0, a1, 0.0, h)]
+        door = room.door
+        if door.wall == wall:
+            g0, g1 = door.center - door.width / 2, door.center + door.width / 2
+            pieces = [(a0, g0, 0.0, h), (g1, a1, 0.0, h), (g0, g1, door.top, h)]
+            pieces.append((g0, g1, 0.0, door.bottom))
+        for p0, p1, z0, z1 in pieces:
+            if p1 - p0 <= 1e-9 or z1 - z0 <= 1e-9:
+                continue
+            lo, hi = ((p0, b0, z0), (p1, b1, z1)) if along_x else ((b0, p0, z0), (b1, p1, z1))
+            boxes.append(_box(lo, hi))
+    return boxes
+
+
+def _structure_meshes(room: Room) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """Floor, Ceiling and Walls as world-space triangle meshes with face colours."""
+    w, d, h, s = room.width, room.depth, room.height, SLAB_THICKNESS
+    parts = {
+        "Floor": ([_box((0.0, 0.0, -s), (w, d, 0.0))], _FLOOR_COLORS.get(room.room_type)),
+        "Ceiling": ([_box((0.0, 0.0, h), (w, d, h + s))], _CEILING_COLOR),
+        "Walls": (_wall_boxes(room), _WALL_COLOR),
+    }
+    meshes = {}
+    for name, (boxes, color) in parts.items():
+        tris = np.concatenate(boxes)
+        faces = np.arange(3 * len(tris), dtype=np.int32).reshape(-1, 3)
+        colors = np.tile(np.asarray(color or _DEFAULT_FLOOR, np.float32), (len(tris), 1))
+        meshes[name] = (tris.reshape(-1, 3), faces, colors)
+    return meshes
+
+
+# ---------------------------------------------------------------------------------- reading
+
+
+def open_layer(path: Path, what: str | None = None) -> Sdf.Layer:
+    """Open one layer (no composition) from disk, reloading a stale copy this process holds.
+
+    Raises:
+        UsdError: the file is missing or is not a readable USD layer.
+    """
+    what = what or str(path)
+    if not Path(path).is_file():
+        raise UsdError(f"{what}: USD file not found")
+    try:
+        layer = Sdf.Layer.Find(str(path))
+        if layer is not None:
+            layer.Reload()
+        else:
+            layer = Sdf.Layer.FindOrOpen(str(path))
+    except Tf.ErrorException as exc:
+        raise UsdError(f"{what}: unreadable USD layer ({_tf_message(exc)})") from None
+    if layer is None:
+        raise UsdError(f"{what}: unreadable USD layer")
+    return layer
+
+
+def _check_sublayers(layer: Sdf.Layer, where: Path, seen: set[str]) -> None:
+    for sub in layer.subLayerPaths:
+        resolved = Path(Sdf.ComputeAssetPathRelativeToLayer(layer, sub))
+        if str(resolved) in seen:
+            continue
+        seen.add(str(resolved))
+        if not resolved.is_file():
+            raise UsdError(f"{where}: sublayer {sub!r} not found (looked for {resolved})")
+        _check_sublayers(open_layer(resolved, f"{where}: sublayer {sub!r}"), where, seen)
+
+
+def open_stage(path: Path, *, strict: bool = True) -> Usd.Stage:
+    """Open a USD file as a composed stage, always from the file's current content on disk.
+
+    Args:
+        path: a ``room.usda``, a ``layout_<k>.usda`` or any USD file.
+        strict: also fail on a missing sublayer or any other composition error.
+
+    Raises:
+        UsdError: the file is missing or unreadable, or (strict) composition fails.
+    """
+    path = Path(path)
+    layer = open_layer(path)
+    if strict:
+        _check_sublayers(layer, path, {str(path.resolve())})
+    try:
+        stage = Usd.Stage.Open(layer)
+    except Tf.ErrorException as exc:
+        raise UsdError(f"{path}: cannot compose stage ({_tf_message(exc)})") from None
+    errors = stage.GetCompositionErrors() if strict else []
+    if errors:
+        kinds = sorted({type(e).__name__.removeprefix("Error") for e in errors})
+        raise UsdError(f"{path}: {len(errors)} composition error(s): {', '.join(kinds)}")
+    return stage
+
+
+def read_room(path: Path) -> Room:
+    """Read a room back from ``room.usda``, or the composed room of a ``layout_<k>.usda``.
+
+    Raises:
+        UsdError: the file is missing, unreadable, does not compose, or lacks a ``sgdata:*``
+            attribute this module writes (the message names the prim and the attribute).
+    """
+    path = Path(path)
+    stage = open_stage(path)
+    root = stage.GetPrimAtPath(ROOT)
+    if not root.IsValid():
+        raise UsdError(f"{path}: no {ROOT} prim; not an sgdata room")
+    size = _get(path, root, "sgdata:roomSize")
+    door = Opening(
+        wall=str(_get(path, root, "sgdata:door:wall")),
+        center=float(_get(path, root, "sgdata:door:center")),
+        width=float(_get(path, root, "sgdata:door:width")),
+        bottom=float(_get(path, root, "sgdata:door:bottom", 0.0)),
+        top=float(_get(path, root, "sgdata:door:top")),
+    )
+    if door.wall not in WALLS:
+        raise UsdError(f"{path}: {ROOT} sgdata:door:wall is {door.wall!r}; expected one of {WALLS}")
+    group = stage.GetPrimAtPath(OBJECTS)
+    prims = list(group.GetChildren()) if group.IsValid() else []
+    instances = {p.GetPath(): int(_get(path, p, "sgdata:instance")) for p in prims}
+    objects = [_read_object(path, prim, instances) for prim in prims]
+    return Room(
+        room_id=str(_get(path, root, "sgdata:roomId")),
+        room_type=str(_get(path, root, "sgdata:roomType")),
+        width=float(size[0]),
+        depth=float(size[1]),
+        height=float(size[2]),
+        seed=int(_get(path, root, "sgdata:seed")),
+        door=door,
+        objects=tuple(objects),
+    )
+
+
+def _read_object(path: Path, prim: Usd.Prim, instances: dict[Sdf.Path, int]) -> SceneObject:
+    dynamics = str(_get(path, prim, "sgdata:dynamics"))
+    try:
+        dyn = Dynamics(dynamics)
+    except ValueError:
+        raise UsdError(
+            f"{path}: {prim.GetPath()} sgdata:dynamics is {dynamics!r}; "
+            f"expected static, low or high"
+        ) from None
+    return SceneObject(
+        instance=instances[prim.GetPath()],
+        class_name=str(_get(path, prim, "sgdata:class")),
+        dynamics=dyn,
+        size=_float3(_get(path, prim, "sgdata:size")),
+        placement=_read_placement(path, prim),
+        variant=int(_get(path, prim, "sgdata:variant", 0)),
+        color=_float3(_get(path, prim, "sgdata:color", Gf.Vec3f(0.7, 0.7, 0.7))),
+        support=_target(path, prim, "sgdata:support", instances),
+        attached_to=_target(path, prim, "sgdata:attachedTo", instances),
+    )
+
+
+def _read_placement(path: Path, prim: Usd.Prim) -> Placement:
+    translate = prim.GetAttribute("xformOp:translate").Get()
+    rotate = prim.GetAttribute("xformOp:rotateZ").Get()
+    if translate is not None and rotate is not None:
+        return Placement(*(float(v) for v in translate), yaw=math.radians(rotate))
+    # authored by another tool: take position and heading from the composed transform
+    m = np.array(UsdGeom.Xformable(prim).ComputeLocalToWorldTransform(Usd.TimeCode.Default()))
+    if not np.isfinite(m).all():
+        raise UsdError(f"{path}: {prim.GetPath()} has no usable transform")
+    return Placement(*(float(v) for v in m[3, :3]), yaw=math.atan2(m[0, 1], m[0, 0]))
+
+
+def _target(path: Path, prim: Usd.Prim, name: str, instances: dict[Sdf.Path, int]) -> int | None:
+    rel = prim.GetRelationship(name)
+    targets = rel.GetTargets() if rel else []
+    if not targets:
+        return None
+    if len(targets) > 1 or targets[0] not in instances:
+        raise UsdError(
+            f"{path}: {prim.GetPath()} {name} targets {[str(t) for t in targets]}; "
+            f"expected one object prim under {OBJECTS}"
+        )
+    return instances[targets[0]]
+
+
+_MISSING = object()
+
+
+def _get(path: Path, prim: Usd.Prim, name: str, default: object = _MISSING) -> object:
+    attr = prim.GetAttribute(name)
+    value = attr.Get() if attr else None
+    if value is None:
+        if default is _MISSING:
+            raise UsdError(f"{path}: {prim.GetPath()} lacks attribute {name}")
+        return default
+    return value
+
+
+def _float3(value: object) -> tuple[float, float, float]:
+    # float32 in the file: its shortest decimal gives back the value that was written
+    a, b, c = (float(str(np.float32(v))) for v in value)  # type: ignore[attr-defined]
+    return (a, b, c)
+
+
+# ------------------------------------------------------------------------------- validation
+
+
+@cache
+def _validators() -> tuple[UsdValidation.Validator, ...]:
+    registry = UsdValidation.ValidationRegistry()
+    names = [m.name for m in registry.GetAllValidatorMetadata() if not m.isSuite]
+    return tuple(registry.GetOrLoadValidatorsByName(sorted(names)))
+
+
+def validate_stage(path: Path) -> list[str]:
+    """Run every validator registered with ``pxr.UsdValidation`` on the composed stage.
+
+    Returns:
+        one line per problem found (errors, warnings and notes alike); empty when clean.
+
+    Raises:
+        UsdError: the file is missing or unreadable (composition errors are reported, not raised).
+    """
+    stage = open_stage(path, strict=False)
+    context = UsdValidation.ValidationContext(list(_validators()))
+    errors = context.Validate(stage)
+    return [_one_line(e.GetErrorAsString()) for e in errors if not e.HasNoError()]
+
+
+def check_stage(path: Path) -> None:
+    """Validate ``path`` like :func:`validate_stage` and raise when anything is reported.
+
+    Raises:
+        UsdError: naming the file, the number of problems and the first of them.
+    """
+    problems = validate_stage(path)
+    if problems:
+        more = f" (and {len(problems) - 1} more)" if len(problems) > 1 else ""
+        raise UsdError(f"{path}: fails USD validation: {problems[0]}{more}")
+
+
+def _tf_message(exc: Tf.ErrorException) -> str:
+    text = " ".join(str(exc).split())
+    return (text.split(" : ", 1)[-1] if " : " in text else text).strip("' ")
+
+
+def _one_line(text: str) -> str:
+    return " ".join(text.split())

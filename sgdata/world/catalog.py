@@ -1,0 +1,224 @@
+"""The object catalog: class specs loaded from ``assets/catalog.toml`` and validated on load."""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass
+from functools import cache
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from sgdata.errors import CatalogError
+from sgdata.world.scene import Dynamics
+
+__all__ = ["PLACEMENTS", "ClassSpec", "Catalog", "load_catalog", "default_catalog_path"]
+
+# How a class is put into a room:
+#   floor       stands on the floor, anywhere free
+#   wall_floor  stands on the floor with its back against a wall (counters, fridges, beds)
+#   wall        hangs on a wall between wall_height[0] and wall_height[1] (bottom edge)
+#   surface     rests on a top surface of one of `receptacles` or inside one of `containers`
+#   part        created only as an attached part of another class's recipe (shelf boards)
+PLACEMENTS = ("floor", "wall_floor", "wall", "surface", "part")
+
+_FIELDS = {
+    "dynamics",
+    "shape",
+    "size_min",
+    "size_max",
+    "placement",
+    "wall_height",
+    "receptacles",
+    "containers",
+    "max_instances",
+    "palette",
+    "variants",
+    "description",
+}
+
+
+@dataclass(frozen=True)
+class ClassSpec:
+    """Everything the generator needs to know about one object class."""
+
+    name: str  # catalog name, AI2-THOR style CamelCase ("CoffeeMachine")
+    dynamics: Dynamics
+    shape: str  # procedural recipe name in sgdata.world.shapes
+    size_min: tuple[float, float, float]  # width, depth, height lower bounds (m)
+    size_max: tuple[float, float, float]  # ... upper bounds (m)
+    placement: str  # one of PLACEMENTS
+    wall_height: tuple[float, float]  # bottom-edge height range for `wall` placement (m)
+    receptacles: tuple[str, ...]  # classes whose top surfaces it may rest on
+    containers: tuple[str, ...]  # classes whose inside surfaces it may rest in
+    max_instances: int  # per room; also the class's run of GCN node slots
+    palette: tuple[tuple[float, float, float], ...]  # main colours, linear RGB in [0, 1]
+    variants: int  # number of shape variants the recipe offers
+    description: str = ""
+
+
+@dataclass(frozen=True, eq=False)  # hashed by identity: loaded once, cached
+class Catalog:
+    """The validated catalog: class specs by name, in file order."""
+
+    classes: dict[str, ClassSpec]
+    source: str  # path or resource name it was read from
+
+    def __getitem__(self, name: str) -> ClassSpec:
+        try:
+            return self.classes[name]
+        except KeyError:
+            raise CatalogError(f"unknown object class {name!r} (not in {self.source})") from None
+
+    def __contains__(self, name: object) -> bool:
+        return name in self.classes
+
+    def __len__(self) -> int:
+        return len(self.classes)
+
+    def names(self) -> list[str]:
+        """Class names in catalog order (the order of the class vocabulary)."""
+        return list(self.classes)
+
+
+def default_catalog_path() -> Path:
+    """The catalog shipped in ``assets/``."""
+    return Path(str(resources.files("sgdata_assets").joinpath("catalog.toml")))
+
+
+@cache
+def _load_cached(path: str) -> Catalog:
+    return _parse(Path(path))
+
+
+def load_catalog(path: str | Path | None = None) -> Catalog:
+    """Load and validate a catalog TOML file (the shipped one by default).
+
+    Raises:
+        CatalogError: naming the file, the class and the field at fault.
+    """
+    resolved = Path(path) if path is not None else default_catalog_path()
+    return _load_cached(str(resolved.resolve()))
+
+
+def _parse(path: Path) -> Catalog:
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise CatalogError(f"{path}: catalog file not found") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise CatalogError(f"{path}: not valid TOML ({exc})") from None
+    table = data.get("classes")
+    if not isinstance(table, dict) or not table:
+        raise CatalogError(f"{path}: expected a [classes.<Name>] table per object class")
+    specs = {name: _parse_class(path, name, entry) for name, entry in table.items()}
+    _check_references(path, specs)
+    return Catalog(classes=specs, source=str(path))
+
+
+def _parse_class(path: Path, name: str, entry: Any) -> ClassSpec:
+    where = f"{path}: class {name}"
+    if not isinstance(entry, dict):
+        raise CatalogError(f"{where}: expected a table of fields")
+    unknown = set(entry) - _FIELDS
+    if unknown:
+        raise CatalogError(
+            f"{where}: unknown field {sorted(unknown)[0]!r}; known: {sorted(_FIELDS)}"
+        )
+    for required in ("dynamics", "shape", "size_min", "size_max", "placement", "palette"):
+        if required not in entry:
+            raise CatalogError(f"{where}: missing field {required!r}")
+    try:
+        dynamics = Dynamics(entry["dynamics"])
+    except ValueError:
+        raise CatalogError(
+            f"{where}: field 'dynamics' is {entry['dynamics']!r}; expected static, low or high"
+        ) from None
+    size_min = _triple(where, "size_min", entry["size_min"])
+    size_max = _triple(where, "size_max", entry["size_max"])
+    if any(lo > hi for lo, hi in zip(size_min, size_max, strict=True)):
+        raise CatalogError(f"{where}: field 'size_min' exceeds 'size_max' {size_max}")
+    placement = entry["placement"]
+    if placement not in PLACEMENTS:
+        raise CatalogError(
+            f"{where}: field 'placement' is {placement!r}; expected one of {PLACEMENTS}"
+        )
+    wall_height = tuple(float(v) for v in entry.get("wall_height", (0.0, 0.0)))
+    if len(wall_height) != 2 or wall_height[0] > wall_height[1]:
+        raise CatalogError(f"{where}: field 'wall_height' must be [low, high] with low <= high")
+    receptacles = _names(where, "receptacles", entry.get("receptacles", []))
+    containers = _names(where, "containers", entry.get("containers", []))
+    if placement == "surface" and not (receptacles or containers):
+        raise CatalogError(f"{where}: placement 'surface' needs 'receptacles' or 'containers'")
+    max_instances = entry.get("max_instances", 1)
+    if not isinstance(max_instances, int) or max_instances < 1:
+        raise CatalogError(f"{where}: field 'max_instances' must be an integer >= 1")
+    variants = entry.get("variants", 1)
+    if not isinstance(variants, int) or variants < 1:
+        raise CatalogError(f"{where}: field 'variants' must be an integer >= 1")
+    palette = entry["palette"]
+    if not isinstance(palette, list) or not palette:
+        raise CatalogError(
+            f"{where}: field 'palette' must be a non-empty list of '#rrggbb' colours"
+        )
+    colors = tuple(_hex_color(where, c) for c in palette)
+    return ClassSpec(
+        name=name,
+        dynamics=dynamics,
+        shape=str(entry["shape"]),
+        size_min=size_min,
+        size_max=size_max,
+        placement=placement,
+        wall_height=(wall_height[0], wall_height[1]),
+        receptacles=receptacles,
+        containers=containers,
+        max_instances=max_instances,
+        palette=colors,
+        variants=variants,
+        description=str(entry.get("description", "")),
+    )
+
+
+def _triple(where: str, key: str, value: Any) -> tuple[float, float, float]:
+    ok = isinstance(value, list) and len(value) == 3
+    ok = ok and all(isinstance(v, int | float) and v > 0 for v in value)
+    if not ok:
+        raise CatalogError(
+            f"{where}: field {key!r} must be 3 positive numbers [width, depth, height]"
+        )
+    return (float(value[0]), float(value[1]), float(value[2]))
+
+
+def _names(where: str, key: str, value: Any) -> tuple[str, ...]:
+    if not isinstance(value, list) or not all(isinstance(v, str) for v in value):
+        raise CatalogError(f"{where}: field {key!r} must be a list of class names")
+    return tuple(value)
+
+
+def _hex_color(where: str, text: Any) -> tuple[float, float, float]:
+    if not (isinstance(text, str) and len(text) == 7 and text.startswith("#")):
+        raise CatalogError(f"{where}: field 'palette' holds {text!r}; expected '#rrggbb'")
+    try:
+        rgb = [int(text[i : i + 2], 16) / 255.0 for i in (1, 3, 5)]
+    except ValueError:
+        raise CatalogError(f"{where}: field 'palette' holds {text!r}; expected '#rrggbb'") from None
+    return (rgb[0], rgb[1], rgb[2])
+
+
+def _check_references(path: Path, specs: dict[str, ClassSpec]) -> None:
+    from sgdata.world.shapes import (
+        RECIPES,  # late: shapes imports trimesh, the catalog file does not need it
+    )
+
+    for spec in specs.values():
+        if spec.shape not in RECIPES:
+            raise CatalogError(
+                f"{path}: class {spec.name}: field 'shape' is {spec.shape!r}; "
+                f"no such recipe in sgdata.world.shapes"
+            )
+        for key in ("receptacles", "containers"):
+            for other in getattr(spec, key):
+                if other not in specs:
+                    raise CatalogError(
+                        f"{path}: class {spec.name}: field {key!r} names unknown class {other!r}"
+                    )

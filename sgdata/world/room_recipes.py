@@ -1,0 +1,136 @@
+"""Room recipes: per room type, what it holds and how it is arranged (``assets/rooms.toml``)."""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass
+from functools import cache
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from sgdata.errors import CatalogError
+from sgdata.world.catalog import Catalog
+
+__all__ = ["ROOM_TYPES", "CountedClass", "RoomRecipe", "load_room_recipes"]
+
+ROOM_TYPES = ("kitchen", "living_room", "bedroom", "bathroom")
+SIDES = ("any", "front", "sides")
+
+
+@dataclass(frozen=True)
+class CountedClass:
+    """A class to add to a room, how many, and an optional anchor class."""
+
+    class_name: str
+    count: tuple[int, int]  # inclusive range
+    near: str | None = None  # furniture: stand beside (and face) an instance of this class
+    above: str | None = None  # wall items: hang above an instance of this class
+    side: str = "any"  # with `near`: which side of the anchor (any | front | sides)
+
+
+@dataclass(frozen=True)
+class RoomRecipe:
+    """How to build one room type."""
+
+    room_type: str
+    size_min: tuple[float, float]
+    size_max: tuple[float, float]
+    height: tuple[float, float]
+    signature: tuple[str, ...]
+    runs: tuple[tuple[str, ...], ...]
+    wall_items: tuple[CountedClass, ...]
+    furniture: tuple[CountedClass, ...]
+    small: tuple[CountedClass, ...]
+
+
+def load_room_recipes(catalog: Catalog, path: str | Path | None = None) -> dict[str, RoomRecipe]:
+    """Load and validate the room recipes against ``catalog``.
+
+    Raises:
+        CatalogError: naming the file, room type and field at fault.
+    """
+    resolved = Path(path) if path is not None else _default_path()
+    return _load(str(resolved.resolve()), catalog)
+
+
+def _default_path() -> Path:
+    return Path(str(resources.files("sgdata_assets").joinpath("rooms.toml")))
+
+
+@cache
+def _load(path: str, catalog: Catalog) -> dict[str, RoomRecipe]:
+    try:
+        data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise CatalogError(f"{path}: room recipe file not found") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise CatalogError(f"{path}: not valid TOML ({exc})") from None
+    table = data.get("room_types", {})
+    missing = [t for t in ROOM_TYPES if t not in table]
+    if missing:
+        raise CatalogError(f"{path}: no [room_types.{missing[0]}] table")
+    return {t: _parse(path, t, table[t], catalog) for t in ROOM_TYPES}
+
+
+def _parse(path: str, room_type: str, entry: dict[str, Any], catalog: Catalog) -> RoomRecipe:
+    where = f"{path}: room type {room_type}"
+
+    def pair(key: str) -> tuple[float, float]:
+        value = entry.get(key)
+        if not (isinstance(value, list) and len(value) == 2 and 0 < value[0] <= value[1]):
+            raise CatalogError(f"{where}: field {key!r} must be [low, high] with 0 < low <= high")
+        return float(value[0]), float(value[1])
+
+    def known(name: Any, key: str) -> str:
+        if name not in catalog:
+            raise CatalogError(f"{where}: field {key!r} names unknown class {name!r}")
+        return str(name)
+
+    def counted(key: str) -> tuple[CountedClass, ...]:
+        items = []
+        for item in entry.get(key, []):
+            if not isinstance(item, dict) or "class" not in item:
+                raise CatalogError(
+                    f"{where}: field {key!r} needs entries like {{class = ..., count = [1, 2]}}"
+                )
+            count = item.get("count", [1, 1])
+            if not (isinstance(count, list) and len(count) == 2 and 0 <= count[0] <= count[1]):
+                raise CatalogError(
+                    f"{where}: field {key!r}: class {item['class']}: count must be [low, high]"
+                )
+            near = item.get("near")
+            above = item.get("above")
+            side = item.get("side", "any")
+            if side not in SIDES:
+                raise CatalogError(
+                    f"{where}: field {key!r}: class {item['class']}: side must be one of {SIDES}"
+                )
+            items.append(
+                CountedClass(
+                    class_name=known(item["class"], key),
+                    count=(int(count[0]), int(count[1])),
+                    near=known(near, key) if near is not None else None,
+                    above=known(above, key) if above is not None else None,
+                    side=side,
+                )
+            )
+        return tuple(items)
+
+    size_lo = entry.get("size_min")
+    size_hi = entry.get("size_max")
+    for key, value in (("size_min", size_lo), ("size_max", size_hi)):
+        if not (isinstance(value, list) and len(value) == 2 and all(v > 1.5 for v in value)):
+            raise CatalogError(f"{where}: field {key!r} must be [width, depth], each > 1.5 m")
+    runs = tuple(tuple(known(name, "runs") for name in run) for run in entry.get("runs", []))
+    return RoomRecipe(
+        room_type=room_type,
+        size_min=(float(size_lo[0]), float(size_lo[1])),
+        size_max=(float(size_hi[0]), float(size_hi[1])),
+        height=pair("height"),
+        signature=tuple(known(name, "signature") for name in entry.get("signature", [])),
+        runs=runs,
+        wall_items=counted("wall_items"),
+        furniture=counted("furniture"),
+        small=counted("small"),
+    )

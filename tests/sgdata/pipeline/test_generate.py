@@ -1,0 +1,138 @@
+"""sgdata generate end to end: determinism, composition, resumability, refusals."""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import duckdb
+import polars as pl
+import pyarrow.parquet as pq
+import pytest
+
+from sgdata.dataset import Dataset
+from sgdata.errors import ConfigError, DatasetError
+from sgdata.pipeline.config import load_config
+from sgdata.pipeline.generate import LEDGER, generate_dataset
+from sgdata.world.triplets import tier_counts
+
+
+def digest_tree(root: Path) -> dict[str, str]:
+    """sha256 of every file a dataset consists of (the ledger excluded)."""
+    return {
+        p.relative_to(root).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest()
+        for p in sorted(root.rglob("*"))
+        if p.is_file() and LEDGER not in p.parts
+    }
+
+
+def test_worker_count_does_not_change_bytes(
+    tmp_path: Path, mini_dataset: Path, mini_config_file: Path
+) -> None:
+    other = tmp_path / "two"
+    generate_dataset(load_config(mini_config_file), other, workers=2)
+    assert digest_tree(other) == digest_tree(mini_dataset)
+
+
+def test_composition_and_offsets(mini_triplets: dict[str, int], mini_dataset: Path) -> None:
+    dataset = Dataset.open(mini_dataset)
+    for split, total in mini_triplets.items():
+        triplets = dataset.triplets(split).to_pylist()
+        tiers = [sum(t["tier"] == k for t in triplets) for k in range(5)]
+        assert tiers == tier_counts(total)
+        obs = {r["obs_id"]: r for r in dataset.observations(split).to_pylist()}
+        for t in triplets:
+            a, p, n = obs[t["anchor"]], obs[t["positive"]], obs[t["negative"]]
+            assert a["room_id"] == p["room_id"] == n["room_id"] == t["room_id"]
+            assert a["split"] == p["split"] == n["split"] == split
+            for other, offset in ((p, t["positive_offset"]), (n, t["negative_offset"])):
+                alpha = other["grid_i"] - a["grid_i"]
+                beta = other["grid_j"] - a["grid_j"]
+                gamma = (other["heading"] - a["heading"]) % 4
+                assert (alpha, beta, gamma) == (offset[0], offset[1], offset[2] % 4)
+            if t["tier"] == 0:
+                assert p["layout"] != a["layout"]
+
+
+def test_standard_tools_read_it(mini_triplets: dict[str, int], mini_dataset: Path) -> None:
+    shard = next((mini_dataset / "observations" / "train").glob("*.parquet"))
+    table = pq.read_table(shard)
+    assert table.num_rows > 0
+    frame = pl.read_parquet(shard)
+    assert frame.height == table.num_rows
+    count = duckdb.sql(
+        f"SELECT count(*) FROM read_parquet('{shard}') AS o, unnest(o.objects) AS u(obj)"
+    ).fetchall()[0][0]
+    assert count == sum(len(objs) for objs in table.column("objects").to_pylist())
+    tiers = duckdb.sql(
+        f"SELECT tier, count(*) FROM '{mini_dataset / 'triplets' / 'train.parquet'}' GROUP BY tier"
+    ).fetchall()
+    assert sum(n for _, n in tiers) == mini_triplets["train"]
+
+
+def test_refuses_to_overwrite(mini_dataset: Path, mini_config_file: Path, tmp_path: Path) -> None:
+    config = load_config(mini_config_file)
+    with pytest.raises(ConfigError, match="holds a finished dataset; pass --force"):
+        generate_dataset(config, mini_dataset)
+    a_file = tmp_path / "file"
+    a_file.write_text("x")
+    with pytest.raises(ConfigError, match="is a file"):
+        generate_dataset(config, a_file)
+
+
+def test_write_error_then_resume(
+    tmp_path: Path, mini_dataset: Path, mini_config_file: Path
+) -> None:
+    config = load_config(mini_config_file)
+    root = tmp_path / "broken"
+    (root / "observations").mkdir(parents=True)
+    (root / "observations" / "test").write_text("a file where a directory must go")
+    with pytest.raises(DatasetError, match="cannot write"):
+        generate_dataset(config, root)
+    assert not (root / "dataset.json").exists()
+    with pytest.raises(ConfigError, match="unfinished generation; pass --resume"):
+        generate_dataset(config, root)
+    (root / "observations" / "test").unlink()
+    generate_dataset(config, root, resume=True)
+    assert digest_tree(root) == digest_tree(mini_dataset)
+
+
+def test_resume_with_another_config_is_refused(tmp_path: Path, mini_config_file: Path) -> None:
+    root = tmp_path / "d"
+    (root / LEDGER).mkdir(parents=True)
+    (root / LEDGER / "config.json").write_text("{}")
+    with pytest.raises(ConfigError, match="another config"):
+        generate_dataset(load_config(mini_config_file), root, resume=True)
+
+
+def test_sigkill_mid_run_then_resume(
+    tmp_path: Path, mini_dataset: Path, mini_config_file: Path
+) -> None:
+    """A real `sgdata generate` process killed with SIGKILL after its first finished room,
+    then resumed, gives the same dataset as an uninterrupted run."""
+    root = tmp_path / "killed"
+    command = [
+        sys.executable,
+        "-m",
+        "sgdata_cli.sgdata_app",
+        "generate",
+        str(mini_config_file),
+        str(root),
+    ]
+    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 240
+    while not list((root / LEDGER).glob("views-*.json")):
+        assert process.poll() is None, process.stderr.read().decode() if process.stderr else ""
+        assert time.monotonic() < deadline, "no room finished in time"
+        time.sleep(0.05)
+    os.kill(process.pid, signal.SIGKILL)
+    process.wait()
+    assert not (root / "dataset.json").exists()
+    resumed = subprocess.run([*command, "--resume"], capture_output=True, text=True, timeout=600)
+    assert resumed.returncode == 0, resumed.stderr
+    assert digest_tree(root) == digest_tree(mini_dataset)
