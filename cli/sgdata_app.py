@@ -120,6 +120,13 @@ def generate(
     workers: Annotated[
         int, typer.Option(help="Worker processes, one renderer each (default: one per core).")
     ] = 0,
+    executor: Annotated[
+        str, typer.Option(help="local (spawned processes) | ray (a Ray cluster or local instance).")
+    ] = "local",
+    address: Annotated[
+        str | None,
+        typer.Option(help="With --executor ray: the cluster to join (default: start one locally)."),
+    ] = None,
     resume: Annotated[bool, typer.Option(help="Continue an interrupted run in OUT.")] = False,
     force: Annotated[bool, typer.Option(help="Overwrite what a previous run left in OUT.")] = False,
 ) -> None:
@@ -148,7 +155,14 @@ def generate(
             bar.update(phases[step.phase], completed=step.done, rate=rate)
 
         manifest = generate_dataset(
-            settings, out, workers=workers, resume=resume, force=force, progress=show
+            settings,
+            out,
+            workers=workers,
+            executor=executor,
+            address=address,
+            resume=resume,
+            force=force,
+            progress=show,
         )
     counts = manifest["counts"]
     table = Table(title=f"{manifest['name']} {manifest['version']} in {out}")
@@ -253,6 +267,51 @@ def report(
     written = write_report(root, output, triplets=triplets, seed=seed)
     for path in written:
         console.print(f"wrote {path}")
+
+
+@app.command()
+def label(
+    photos: Annotated[Path, typer.Argument(help="Directory of PNG / JPEG photos to label.")],
+    out: Annotated[Path, typer.Option("--out", help="Dataset directory (labels/ is kept there).")],
+    port: Annotated[int, typer.Option(help="Port of the labeling page.")] = 8765,
+    host: Annotated[
+        str, typer.Option(help="Address to bind; anything but loopback exposes your photos.")
+    ] = "127.0.0.1",
+    classes: Annotated[
+        Path | None,
+        typer.Option("--classes", help="TOML mapping extra class names to catalog classes."),
+    ] = None,
+    export: Annotated[
+        bool, typer.Option("--export", help="Write the labels as a real dataset and exit.")
+    ] = False,
+    split: Annotated[str, typer.Option(help="Split of the exported rooms.")] = "test",
+) -> None:
+    """Label real photos in a local web page (boxes, classes, relations), or --export them."""
+    if export:
+        from sgdata.label.export import export_dataset
+
+        done = export_dataset(photos, out, class_map=classes, split=split)
+        console.print(
+            f"wrote {done.observations} observation(s) of {done.rooms} room(s) and "
+            f"{done.triplets} triplet(s) to {done.root} (split {done.split})"
+        )
+        if done.unlabeled:
+            console.print(f"left out {len(done.unlabeled)} photo(s) without a room id")
+        if done.pending:
+            console.print(f"{done.pending} undecided proposal(s) stored as disjoint")
+        for note in done.notes:
+            console.print(note, markup=False)
+        return
+    from sgdata.label.server import serve
+
+    serve(
+        photos,
+        out,
+        host=host,
+        port=port,
+        class_map=classes,
+        on_ready=lambda url: console.print(f"labeling {photos} at {url} (Ctrl-C stops)"),
+    )
 
 
 main = run_app(app, "sgdata")

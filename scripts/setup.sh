@@ -5,7 +5,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-debs=(libegl1 libegl-mesa0 libgl1-mesa-dri libgles2 libusb-1.0-0)
+# chromium: the labeling tests drive the real `sgdata label` page in headless Chromium
+debs=(libegl1 libegl-mesa0 libgl1-mesa-dri libgles2 libusb-1.0-0 chromium)
 missing=()
 for pkg in "${debs[@]}"; do
   dpkg -s "$pkg" >/dev/null 2>&1 || missing+=("$pkg")

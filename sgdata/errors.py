@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 __all__ = [
+    "WorkerError",
     "SgdataError",
     "ConfigError",
     "CatalogError",
@@ -39,3 +40,7 @@ class RenderError(SgdataError):
 
 class DatasetError(SgdataError):
     """A dataset on disk is missing, malformed, or of an unsupported format version."""
+
+
+class WorkerError(SgdataError):
+    """A room task failed on every try, its worker died, or the executor could not start."""

@@ -1,10 +1,15 @@
-"""Shared test fixtures: a tiny hand-built room with its render geometry, and one renderer."""
+"""Shared test fixtures: a tiny hand-built room with its render geometry, one renderer, the
+mini dataset, process probes, and a session-end check that no process of the run survives."""
 
 from __future__ import annotations
 
+import os
+import sys
+import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -218,3 +223,101 @@ def mini_dataset(tmp_path_factory: pytest.TempPathFactory, mini_config_file: Pat
     root = tmp_path_factory.mktemp("mini_dataset") / "data"
     generate_dataset(load_config(mini_config_file), root, workers=2)
     return root
+
+
+# --------------------------------------------------------------------------- processes
+
+
+def _stat(pid: int) -> tuple[int, int, int, int] | None:
+    """(ppid, pgid, sid, start time in clock ticks) of a live process, None if gone."""
+    try:
+        text = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return None
+    fields = text.rsplit(")", 1)[1].split()
+    if fields[0] == "Z":  # a zombie has exited; only its parent's wait is missing
+        return None
+    return int(fields[1]), int(fields[2]), int(fields[3]), int(fields[19])
+
+
+def _cmdline(pid: int) -> str:
+    try:
+        return (
+            Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
+        )
+    except OSError:
+        return ""
+
+
+def live_pids() -> list[int]:
+    return [int(p) for p in os.listdir("/proc") if p.isdigit()]
+
+
+def in_group(pgid: int) -> list[int]:
+    """Live processes of process group ``pgid``."""
+    return [p for p in live_pids() if (s := _stat(p)) is not None and s[1] == pgid]
+
+
+def ancestors(pid: int) -> set[int]:
+    found = set()
+    while pid > 1 and (s := _stat(pid)) is not None:
+        found.add(pid)
+        pid = s[0]
+    return found
+
+
+def strays_since(start_ticks: int, *, exclude: set[int]) -> list[str]:
+    """Live processes of this project's environment (their command line names this venv)
+    started since ``start_ticks``, other than ``exclude``: what a run left behind."""
+    out = []
+    for pid in live_pids():
+        s = _stat(pid)
+        if pid in exclude or s is None or s[3] < start_ticks:
+            continue
+        command = _cmdline(pid)
+        if sys.prefix in command:
+            out.append(f"{pid}: {command[:120]}")
+    return out
+
+
+def start_ticks(pid: int) -> int:
+    s = _stat(pid)
+    assert s is not None
+    return s[3]
+
+
+def wait_until_gone(find, seconds: float = 10.0) -> list:  # noqa: ANN001
+    """Poll ``find()`` until it returns nothing or ``seconds`` pass; the last result."""
+    deadline = time.monotonic() + seconds
+    while (left := find()) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    return left
+
+
+@pytest.fixture(scope="session")
+def procs() -> SimpleNamespace:
+    """The /proc probes above, for tests that kill real runs."""
+    return SimpleNamespace(
+        in_group=in_group,
+        strays_since=strays_since,
+        start_ticks=start_ticks,
+        wait_until_gone=wait_until_gone,
+        ancestors=ancestors,
+    )
+
+
+def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
+    """Fail the run when a process it started outlives it (a pool worker, a resource
+    tracker, a Ray process): `make test` must leave nothing behind."""
+    from multiprocessing import resource_tracker
+
+    # This process's own resource tracker ends with it by design (its pipe closes); stop it
+    # now so that what remains is what would really outlive the run.
+    resource_tracker._resource_tracker._stop()
+    me = os.getpid()
+    left = wait_until_gone(
+        lambda: strays_since(start_ticks(me), exclude=ancestors(me)), seconds=15.0
+    )
+    if left:
+        print("\nprocesses started by the test run are still alive:\n  " + "\n  ".join(left))
+        session.exitstatus = pytest.ExitCode.TESTS_FAILED

@@ -13,6 +13,7 @@ _EXPORTS = {
     "RelationType": ".relations",
     "Relations": ".relations",
     "compute_relations": ".relations",
+    "stored_precision": ".relations",
     "NUM_SLOTS": ".slots",
     "SlotAssignment": ".slots",
     "SlotTable": ".slots",

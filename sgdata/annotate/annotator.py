@@ -10,7 +10,7 @@ import numpy as np
 
 from sgdata.annotate.boxes import ObjectTable, annotate
 from sgdata.annotate.records import ViewPose, ViewRecord
-from sgdata.annotate.relations import RelationRules, compute_relations
+from sgdata.annotate.relations import RelationRules, compute_relations, stored_precision
 from sgdata.annotate.slots import SlotTable
 from sgdata.errors import RenderError
 from sgdata.render.camera import CameraConfig
@@ -83,7 +83,10 @@ class ViewAnnotator:
             rows, classes = rows[keep], [c for c, k in zip(classes, keep, strict=True) if k]
         box2d = ann.box2d[keep] if not keep.all() else ann.box2d
         visible = ann.visible_pixels[keep] if not keep.all() else ann.visible_pixels
-        lo, hi, sup = table.aabb_min[rows], table.aabb_max[rows], table.support[rows]
+        # Relations are decided on exactly the boxes the dataset stores (float32), so that
+        # `sgdata validate` recomputes every pair with no allowance and agrees.
+        lo, hi = (stored_precision(b[rows]) for b in (table.aabb_min, table.aabb_max))
+        sup = table.support[rows]
         inst = table.instance[rows]
         rel = compute_relations(inst, lo, hi, sup, rules=self.rules)
         return ViewRecord(

@@ -1,43 +1,113 @@
-"""Where room tasks run: a pool of spawned worker processes, even for one worker.
+"""Where room tasks run: a local pool of spawned worker processes, or Ray actors.
+
+Both executors run the same per-room functions (:mod:`sgdata.pipeline.room_tasks`) with the
+same plain arguments; every output is written by the task itself, so the dataset's bytes do
+not depend on which executor ran it, in which order, or on how many workers.
 
 Workers are spawned, never forked: an EGL context does not survive ``fork`` (DESIGN §9). Each
-worker keeps its renderer alive across the rooms it is given (see
-:mod:`sgdata.pipeline.room_tasks`).
+worker keeps its renderer alive across the rooms it is given. Every worker rasterises on one
+llvmpipe thread (``LP_NUM_THREADS=1``, ignored by GPU EGL): llvmpipe's output can differ in
+edge pixels with its thread count, and parallelism comes from the workers instead (two
+single-threaded workers render 2.1x the views of one default process on 2 cores).
 
-Every worker rasterises on one llvmpipe thread (``LP_NUM_THREADS=1``, ignored by GPU EGL):
-llvmpipe's output differs in rare edge pixels with its thread count (seen here: one pixel of
-one view in 23), so a fixed count is what makes a dataset byte-identical whatever
-``--workers`` is. Parallelism comes from the workers instead: two single-threaded workers
-render 2.1x the views of one default process on 2 cores (DESIGN §9).
+No worker outlives its parent: local workers ask the kernel for SIGKILL when their parent dies
+(``PR_SET_PDEATHSIG``) and re-check the parent's pid once armed, so a ``kill -9`` of
+``sgdata generate`` takes them with it (the multiprocessing resource tracker then sees its pipe
+close and exits too). A local Ray instance started by the run shares the driver's fate the
+same way (Ray starts its processes with ``fate_share``).
 """
 
 from __future__ import annotations
 
+import ctypes
 import multiprocessing
 import os
+import signal
 from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from contextlib import contextmanager
 from typing import Any
 
-__all__ = ["run_tasks"]
+from sgdata.errors import ConfigError
+
+__all__ = ["EXECUTORS", "WORKER_ENV", "run_tasks", "executor_session", "die_with_parent"]
+
+EXECUTORS = ("local", "ray")
+WORKER_ENV = {"LP_NUM_THREADS": "1"}  # set in every worker before pyrender or Mesa load
+_PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
 
 
 def run_tasks(
-    fn: Callable[..., dict], payloads: Iterable[tuple], *, workers: int = 1
+    fn: Callable[..., dict],
+    payloads: Iterable[tuple],
+    *,
+    workers: int = 1,
+    executor: str = "local",
+    address: str | None = None,
+    retries: int = 2,
 ) -> Iterator[dict]:
     """Run ``fn(*payload)`` for every payload; yield results as they finish.
 
-    A worker's exception (an ``SgdataError`` included) is re-raised here after the pool is
-    shut down, so finished tasks stay recorded and the run can resume.
+    Args:
+        executor: ``local`` (a pool of spawned processes) or ``ray``.
+        address: with ``ray``, the cluster to join (``ray start --head`` prints it); without
+            it, a local instance bound to 127.0.0.1 with the dashboard off.
+        retries: with ``ray``, how often a task whose worker died is tried again.
+
+    A task's exception (an ``SgdataError`` included) is re-raised here after the workers are
+    stopped, so finished tasks stay recorded and the run can resume.
     """
+    _check(executor, address)
     jobs = list(payloads)
     if not jobs:
         return
+    if executor == "ray":
+        run_on_ray = _ray_executor().run_on_ray
+
+        yield from run_on_ray(fn, jobs, workers=workers, address=address, retries=retries)
+        return
+    yield from _run_local(fn, jobs, workers=workers)
+
+
+@contextmanager
+def executor_session(executor: str, *, workers: int, address: str | None) -> Iterator[None]:
+    """Keep the executor's engine up across several :func:`run_tasks` calls (a local Ray
+    instance starts once per generation, not once per phase)."""
+    _check(executor, address)
+    if executor != "ray":
+        yield
+        return
+    with _ray_executor().ray_session(address, workers):
+        yield
+
+
+def _ray_executor():  # noqa: ANN202
+    """The Ray executor module; a clear error when Ray is not installed."""
+    try:
+        from sgdata.pipeline import ray_executor
+    except ModuleNotFoundError as exc:
+        if exc.name != "ray":
+            raise
+        raise ConfigError(
+            "--executor ray needs Ray: pip install 'sgdata[ray]' (or pip install 'ray==2.60.*')"
+        ) from None
+    return ray_executor
+
+
+def _check(executor: str, address: str | None) -> None:
+    if executor not in EXECUTORS:
+        raise ConfigError(f"--executor {executor!r}: expected one of {', '.join(EXECUTORS)}")
+    if address is not None and executor != "ray":
+        raise ConfigError("--address is for --executor ray; drop it or add --executor ray")
+
+
+def _run_local(fn: Callable[..., dict], jobs: list[tuple], *, workers: int) -> Iterator[dict]:
     context = multiprocessing.get_context("spawn")
     with ProcessPoolExecutor(
         max_workers=min(workers, len(jobs)),
         mp_context=context,
         initializer=_init_worker,
+        initargs=(os.getpid(),),
     ) as pool:
         pending: set[Future[Any]] = {pool.submit(fn, *payload) for payload in jobs}
         try:
@@ -51,6 +121,19 @@ def run_tasks(
             raise
 
 
-def _init_worker() -> None:
+def die_with_parent(parent: int) -> None:
+    """Ask the kernel to SIGKILL this process when its parent dies (Linux); if the parent is
+    already gone (it died before this ran), exit now."""
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+    except (OSError, AttributeError):  # not Linux: the parent's own shutdown stops the workers
+        return
+    if os.getppid() != parent:
+        os._exit(1)
+
+
+def _init_worker(parent: int) -> None:
     # Runs first in each spawned worker, before pyrender or Mesa load.
-    os.environ["LP_NUM_THREADS"] = "1"
+    die_with_parent(parent)
+    os.environ.update(WORKER_ENV)

@@ -26,7 +26,7 @@ from sgdata.dataset.paths import MANIFEST, OUTPUTS, SPLITS, scene_dir
 from sgdata.errors import ConfigError
 from sgdata.fileio import atomic_write_text, prepare_output_dir, remove_stale_temps
 from sgdata.pipeline.config import GenerateConfig, config_to_dict
-from sgdata.pipeline.executors import run_tasks
+from sgdata.pipeline.executors import executor_session, run_tasks
 from sgdata.pipeline.ledger import (
     CONFIG_RECORD,
     LEDGER,
@@ -72,11 +72,16 @@ def generate_dataset(
     root: Path,
     *,
     workers: int = 1,
+    executor: str = "local",
+    address: str | None = None,
     resume: bool = False,
     force: bool = False,
     progress: Callable[[GenerateProgress], None] | None = None,
 ) -> dict:
     """Generate the dataset described by ``config`` into ``root``; returns the manifest dict.
+
+    ``executor`` is ``local`` (spawned processes) or ``ray`` (``address`` joins a cluster,
+    without it a local instance); the bytes written are the same whatever runs them.
 
     Raises:
         ConfigError: ``root`` is a file, holds a finished dataset (without ``force``), holds
@@ -87,9 +92,20 @@ def generate_dataset(
     if workers < 1:
         raise ConfigError(f"--workers must be >= 1, got {workers}")
     _prepare_root(root, config, resume=resume, force=force)
+    with executor_session(executor, workers=workers, address=address):
+        engine = {"workers": workers, "executor": executor, "address": address}
+        return _generate(config, root, engine, progress)
+
+
+def _generate(
+    config: GenerateConfig,
+    root: Path,
+    engine: dict,
+    progress: Callable[[GenerateProgress], None] | None,
+) -> dict:
     tasks = plan_rooms(config)
     scene_jobs = [t for t in tasks if not scene_record(root, t.room_id).exists()]
-    _run_phase("scenes", scene_jobs, len(tasks), config, root, workers, progress)
+    _run_phase("scenes", scene_jobs, len(tasks), config, root, engine, progress)
     grids = {t.room_id: read_record(scene_record(root, t.room_id)) for t in tasks}
 
     triplets = {split: _split_triplets(config, split, tasks, grids) for split in SPLITS}
@@ -97,7 +113,7 @@ def generate_dataset(
     view_jobs = [
         (t, poses.get(t.room_id, [])) for t in tasks if not views_record(root, t.room_id).exists()
     ]
-    _run_phase("views", view_jobs, len(tasks), config, root, workers, progress)
+    _run_phase("views", view_jobs, len(tasks), config, root, engine, progress)
 
     shards = [read_record(views_record(root, t.room_id)) for t in tasks]
     return _finish(root, config, tasks, shards, triplets)
@@ -210,7 +226,7 @@ def _run_phase(
     total: int,
     config: GenerateConfig,
     root: Path,
-    workers: int,
+    engine: dict,
     progress: Callable[[GenerateProgress], None] | None,
 ) -> None:
     from sgdata.pipeline.room_tasks import render_room_views, write_room_scenes
@@ -224,7 +240,7 @@ def _run_phase(
     else:
         payloads = [(task, list(poses), config, root) for task, poses in jobs]
         fn = render_room_views
-    for result in run_tasks(fn, payloads, workers=workers):
+    for result in run_tasks(fn, payloads, **engine):
         done += 1
         views += int(result.get("views", 0))
         if progress is not None:

@@ -116,6 +116,7 @@ class Renderer:
 
             self._pr = pyrender
             self._gl = pyrender.OffscreenRenderer(self.camera.width, self.camera.height)
+            self._gl._renderer._sorted_mesh_nodes = self._draw_order
         except Exception as exc:  # any failure here is an environment problem, not a bug
             why = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
             raise RenderError(_EGL_HINT.format(why=why)) from None
@@ -124,6 +125,7 @@ class Renderer:
         self._meshes: list[MeshData] = []
         self._structure: tuple[MeshData, ...] = ()
         self._scene: Any = None
+        self._rank: dict[Any, int] = {}  # mesh node -> the order it was added in
         self._merged_node: Any = None
         self._seg_map: dict[Any, np.ndarray] = {}
         self._instance_lut = np.full(1, -1, dtype=np.int32)  # dense index + 1 -> instance
@@ -156,9 +158,10 @@ class Renderer:
         self._instance_lut = np.array((-1, *self._instances), dtype=np.int32)
         # a dim hallway grey behind the door gap rather than a black hole
         sc = pr.Scene(bg_color=[0.45, 0.45, 0.48, 1.0], ambient_light=[self.ambient] * 3)
+        self._scene, self._rank = sc, {}
         for m in scene.structure:
-            sc.add(pr.Mesh([_primitive(pr, m, double_sided=True)]))
-        self._merged_node = sc.add(pr.Mesh([_primitive(pr, _merged_world(scene.objects))]))
+            self._add(pr.Mesh([_primitive(pr, m, double_sided=True)]))
+        self._merged_node = self._add(pr.Mesh([_primitive(pr, _merged_world(scene.objects))]))
         self._cam_node = sc.add(self._camera_model())
         # Key light rides with the camera (faces towards the viewer always read), fill light
         # hangs under the ceiling's centre so tops and fronts of boxes differ in shade. One
@@ -176,12 +179,36 @@ class Renderer:
         self._seg_map = {node: zero for node in sc.mesh_nodes if node is not self._merged_node}
         self._object_nodes = []
         for code, (mesh, matrix) in enumerate(zip(self._meshes, self._matrices, strict=True), 1):
-            node = sc.add(pr.Mesh([_primitive(pr, mesh)]), pose=matrix)
+            node = self._add(pr.Mesh([_primitive(pr, mesh)]), pose=matrix)
             node.mesh.is_visible = False
             self._object_nodes.append(node)
             self._seg_map[node] = np.array([code & 255, (code >> 8) & 255, code >> 16])
-        self._scene = sc
         self._rc = None  # built on the first raycast id pass
+
+    def _add(self, node_or_mesh: Any, **kwargs: Any) -> Any:
+        """Add to the scene, remembering the order (the draw order's tie-break)."""
+        node = self._scene.add(node_or_mesh, **kwargs)
+        self._rank[node] = len(self._rank)
+        return node
+
+    def _draw_order(self, scene: Any) -> list[Any]:
+        """The mesh nodes in the order pyrender draws them: opaque before transparent, far to
+        near, and, at equal distance, in the order they were added.
+
+        pyrender keeps mesh nodes in a set and sorts them by distance alone, so nodes at the
+        same distance (the structure and the merged objects all sit at the origin) were drawn
+        in an order that followed memory addresses and changed from run to run. Coplanar faces
+        (a painting flush with its wall, a rug on the floor) then z-fought differently: one
+        pixel of one view in ~50 differed between two identical runs. This replaces pyrender's
+        ``Renderer._sorted_mesh_nodes`` on this renderer's instance only.
+        """
+        eye = scene.get_pose(scene.main_camera_node)[:3, 3]
+
+        def key(node: Any) -> tuple[bool, float, int]:
+            far = -float(np.linalg.norm(scene.get_pose(node)[:3, 3] - eye))
+            return (bool(node.mesh.is_transparent), far, self._rank.get(node, -1))
+
+        return sorted(scene.mesh_nodes, key=key)
 
     def update_poses(self, scene: SceneGeometry) -> bool:
         """Move the loaded objects to a new layout of the same room.
@@ -202,7 +229,8 @@ class Renderer:
             return True
         self._matrices = [np.asarray(o.matrix) for o in scene.objects]
         self._scene.remove_node(self._merged_node)
-        self._merged_node = self._scene.add(
+        self._rank.pop(self._merged_node, None)
+        self._merged_node = self._add(
             self._pr.Mesh([_primitive(self._pr, _merged_world(scene.objects))])
         )
         for node, matrix in zip(self._object_nodes, self._matrices, strict=True):

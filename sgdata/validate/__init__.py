@@ -12,7 +12,11 @@ import time
 from pathlib import Path
 
 from sgdata.dataset.schema import FORMAT_VERSION, _parse_version
-from sgdata.validate.composition_checks import check_rooms_across_splits, check_triplets
+from sgdata.validate.composition_checks import (
+    check_counts,
+    check_rooms_across_splits,
+    check_triplets,
+)
 from sgdata.validate.image_checks import check_images
 from sgdata.validate.logic_checks import check_objects, check_relations, check_rows
 from sgdata.validate.manifest_checks import (
@@ -83,4 +87,5 @@ def _check_contents(root: Path, raw: dict, out: Collector, *, quick: bool, usd: 
         if not quick:
             check_images(root, tables.files, out)
     check_rooms_across_splits(splits, out)
+    check_counts(splits, raw, out)
     check_scenes(root, splits, out, usd=usd)

@@ -15,7 +15,7 @@ from sgdata.validate.loading import SplitTables, column_numpy, fixed_numpy
 from sgdata.validate.problems import Collector
 from sgdata.world.triplets import TIERS, tier_counts
 
-__all__ = ["check_triplets", "check_rooms_across_splits", "ROLES"]
+__all__ = ["check_triplets", "check_rooms_across_splits", "check_counts", "ROLES"]
 
 ROLES = ("anchor", "positive", "negative")
 _POINT = 0.01  # shares must hold within ±1 percentage point (DESIGN §6)
@@ -200,3 +200,34 @@ def check_rooms_across_splits(splits: list[SplitTables], out: Collector) -> None
                 )
             else:
                 seen[room] = tables.split
+
+
+def check_counts(splits: list[SplitTables], raw: dict[str, Any], out: Collector) -> None:
+    """Every count of the manifest (rooms, observations, triplets, tiers per split) against
+    what the files hold."""
+    counts = raw.get("counts", {})
+
+    def compare(name: str, field: str, stated: Any, actual: Any) -> None:
+        out.count("counts." + name)
+        if stated != actual:
+            out.add(
+                "counts." + name,
+                MANIFEST,
+                f"counts say {stated}, the files hold {actual}",
+                field=f"counts/{field}",
+            )
+
+    rooms = sum(len(r) for r in raw.get("splits", {}).values())
+    compare("rooms", "rooms", counts.get("rooms"), rooms)
+    for tables in splits:
+        split = tables.split
+        if tables.observations is not None:
+            stated = counts.get("observations", {}).get(split)
+            compare("observations", f"observations/{split}", stated, tables.observations.num_rows)
+        if tables.triplets is not None:
+            stated = counts.get("triplets", {}).get(split)
+            compare("triplets", f"triplets/{split}", stated, tables.triplets.num_rows)
+            tier = column_numpy(tables.triplets, "tier").astype(np.int64)
+            valid = tier[(tier >= 0) & (tier < len(TIERS))]
+            actual = np.bincount(valid, minlength=len(TIERS)).tolist()
+            compare("tiers", f"tiers/{split}", counts.get("tiers", {}).get(split), actual)

@@ -35,8 +35,9 @@ def _report(
 
 
 def check_rows(tables: SplitTables, raw: dict[str, Any], out: Collector) -> None:
-    """Row-level rules: poses present for synthetic rows and null grid for real ones; the
-    camera size is the manifest's."""
+    """Row-level rules: poses present for synthetic rows; a real row's grid pose (grid_i,
+    grid_j, heading) all set (a photo labeled with its pose) or all null; the camera size is
+    the manifest's for synthetic rows."""
     obs = tables.observations
     if obs is None:
         return
@@ -44,14 +45,18 @@ def check_rows(tables: SplitTables, raw: dict[str, Any], out: Collector) -> None
     rows = np.arange(n)
     synthetic = column_numpy(obs, "domain") == "synthetic"
     out.count("rows.pose", n)
-    for name in ("x", "y", "theta", "grid_i", "grid_j", "heading"):
+    grid = ("grid_i", "grid_j", "heading")
+    grid_null = [obs.column(name).is_null().to_numpy(zero_copy_only=False) for name in grid]
+    partial = np.any(grid_null, axis=0) & ~np.all(grid_null, axis=0)
+    for name in ("x", "y", "theta", *grid):
         null = obs.column(name).is_null().to_numpy(zero_copy_only=False)
         _report(out, tables, "rows.pose", synthetic & null, rows, name, "null in a synthetic row")
-        if name in ("grid_i", "grid_j", "heading"):
-            msg = "set in a real row; real photos have no grid pose (expected null)"
-            _report(out, tables, "rows.pose", ~synthetic & ~null, rows, name, msg)
+        if name in grid:
+            msg = "null while the row's other grid fields are set (expected all three or none)"
+            _report(out, tables, "rows.pose", ~synthetic & partial & null, rows, name, msg)
     heading = column_numpy(obs, "heading", -1)
-    bad = synthetic & ((heading < 0) | (heading > 3))
+    posed = synthetic | ~grid_null[2]
+    bad = posed & ((heading < 0) | (heading > 3))
     _report(
         out, tables, "rows.pose", bad, rows, "heading", lambda k: f"{heading[k]}: expected 0..3"
     )

@@ -1,9 +1,6 @@
 """Relations recomputed from the stored 3D boxes and supports with
-:func:`sgdata.relations.compute_relations` (the manifest's rules) must equal the stored ones.
-
-The boxes are stored as float32 while the generator decided on float64 boxes, so a pair whose
-decision lies within :data:`BORDER` metres of a rule's boundary (a box face flush with another,
-two spheres just touching) can flip by rounding alone: such pairs are not compared.
+:func:`sgdata.annotate.relations.compute_relations` (the manifest's rules) must equal the stored
+ones, every pair, with no allowance: the generator decides on exactly the stored float32 boxes.
 """
 
 from __future__ import annotations
@@ -17,34 +14,7 @@ from sgdata.errors import ConfigError
 from sgdata.validate.loading import Flat, SplitTables, column_numpy
 from sgdata.validate.problems import Collector
 
-__all__ = ["BORDER", "borderline_pairs", "check_recompute"]
-
-BORDER = 1e-5  # metres: far above float32 rounding of room coordinates (< 1e-6 m), far below 1 mm
-
-
-def borderline_pairs(lo: np.ndarray, hi: np.ndarray, tol: float, eps: float = BORDER) -> np.ndarray:
-    """(n, n) bool: pairs whose in / proximity decision float32 rounding could flip."""
-    loose = strict = None
-    for k in range(3):
-        a = (lo[:, k, None] >= lo[None, :, k] - tol - eps) & (
-            hi[:, k, None] <= hi[None, :, k] + tol + eps
-        )
-        b = (lo[:, k, None] >= lo[None, :, k] - tol + eps) & (
-            hi[:, k, None] <= hi[None, :, k] + tol - eps
-        )
-        loose = a if loose is None else loose & a
-        strict = b if strict is None else strict & b
-    size = hi - lo
-    vol = size.prod(axis=1)
-    tie = np.abs(vol[:, None] - vol[None, :]) <= eps * (
-        1.0 + np.maximum(vol[:, None], vol[None, :])
-    )
-    border = (loose & ~strict) | (tie & loose)
-    centre = (lo + hi) / 2
-    radius = 0.5 * np.linalg.norm(size, axis=1)
-    dist = np.linalg.norm(centre[:, None, :] - centre[None, :, :], axis=2)
-    border |= np.abs(dist - (radius[:, None] + radius[None, :])) <= 4 * eps
-    return border | border.T
+__all__ = ["check_recompute"]
 
 
 def _rules(raw: dict[str, Any]) -> RelationRules:
@@ -91,10 +61,6 @@ def check_recompute(
         recomputed = set(zip(got.src.tolist(), got.dst.tolist(), got.type.tolist(), strict=True))
         if stored == recomputed:
             continue
-        order = np.argsort(inst, kind="stable")
-        border = borderline_pairs(lo[a:b][order], hi[a:b][order], rules.containment_tolerance)
-        ids = inst[order]
-        sup = dict(zip(inst.tolist(), support[a:b].tolist(), strict=True))
 
         def pair_of(edge: tuple[int, int, int]) -> tuple[int, int]:
             return (min(edge[0], edge[1]), max(edge[0], edge[1]))
@@ -107,11 +73,6 @@ def check_recompute(
                 )
         f, file_row = tables.where(row)
         for (x, y), (was, now) in sorted(diff.items()):
-            i, j = np.searchsorted(ids, x), np.searchsorted(ids, y)
-            known = i < len(ids) and j < len(ids) and ids[i] == x and ids[j] == y
-            rests = sup.get(x) == y or sup.get(y) == x
-            if known and border[i, j] and not rests:
-                continue  # within float32 rounding of a rule boundary
             out.add(
                 "relations.recompute",
                 tables.files[f],

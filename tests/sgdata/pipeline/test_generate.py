@@ -110,11 +110,17 @@ def test_resume_with_another_config_is_refused(tmp_path: Path, mini_config_file:
         generate_dataset(load_config(mini_config_file), root, resume=True)
 
 
+@pytest.mark.parametrize("executor", ["local", "ray"])
 def test_sigkill_mid_run_then_resume(
-    tmp_path: Path, mini_dataset: Path, mini_config_file: Path
+    tmp_path: Path,
+    mini_dataset: Path,
+    mini_config_file: Path,
+    procs,
+    executor: str,  # noqa: ANN001
 ) -> None:
-    """A real `sgdata generate` process killed with SIGKILL after its first finished room,
-    then resumed, gives the same dataset as an uninterrupted run."""
+    """A real `sgdata generate` process killed with SIGKILL after its first finished room
+    takes every process of the run with it (workers, resource tracker, Ray); resumed, it
+    gives the same dataset as an uninterrupted run."""
     root = tmp_path / "killed"
     command = [
         sys.executable,
@@ -123,8 +129,16 @@ def test_sigkill_mid_run_then_resume(
         "generate",
         str(mini_config_file),
         str(root),
+        "--workers",
+        "2",
     ]
-    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    process = subprocess.Popen(
+        [*command, "--executor", executor],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        start_new_session=True,  # its own process group: everything it starts is findable
+    )
+    started = procs.start_ticks(process.pid)
     deadline = time.monotonic() + 240
     while not list((root / LEDGER).glob("views-*.json")):
         assert process.poll() is None, process.stderr.read().decode() if process.stderr else ""
@@ -132,6 +146,9 @@ def test_sigkill_mid_run_then_resume(
         time.sleep(0.05)
     os.kill(process.pid, signal.SIGKILL)
     process.wait()
+    mine = procs.ancestors(os.getpid())
+    assert procs.wait_until_gone(lambda: procs.in_group(process.pid)) == []
+    assert procs.wait_until_gone(lambda: procs.strays_since(started, exclude=mine)) == []
     assert not (root / "dataset.json").exists()
     resumed = subprocess.run([*command, "--resume"], capture_output=True, text=True, timeout=600)
     assert resumed.returncode == 0, resumed.stderr

@@ -261,3 +261,34 @@ def test_manifest_schema_and_version(copy: Path) -> None:
     edit_manifest(copy, lambda raw: raw.update(format_version="2.0.0"))
     report = validate_dataset(copy, quick=True)
     assert "newer" in find(report, "manifest.version")[0].message
+
+
+@pytest.mark.parametrize(
+    ("path", "check"),
+    [
+        (("observations", "train"), "counts.observations"),
+        (("triplets", "val"), "counts.triplets"),
+        (("rooms",), "counts.rooms"),
+    ],
+)
+def test_manifest_count_off_by_one(copy: Path, path: tuple[str, ...], check: str) -> None:
+    def bump(manifest: dict) -> None:
+        parent = manifest["counts"]
+        for key in path[:-1]:
+            parent = parent[key]
+        parent[path[-1]] += 1
+
+    edit_manifest(copy, bump)
+    report = validate_dataset(copy, quick=True)
+    assert check in checks(report)  # (a count that disagrees with another may be flagged too)
+    (problem,) = find(report, check)
+    assert problem.file == "dataset.json" and "the files hold" in problem.message
+
+
+def test_manifest_tier_counts_checked(copy: Path) -> None:
+    def shift(manifest: dict) -> None:
+        tiers = manifest["counts"]["tiers"]["test"]
+        tiers[0], tiers[1] = tiers[0] - 1, tiers[1] + 1
+
+    edit_manifest(copy, shift)
+    assert "counts.tiers" in checks(validate_dataset(copy, quick=True))
