@@ -39,7 +39,7 @@ test = 0
 """
 
 
-def run_one(rooms: int, workers: int) -> dict:
+def run_one(rooms: int, workers: int, executor: str = "local") -> dict:
     """Generate in this process; report counts, times and peak memory (MiB)."""
     from sgdata.pipeline.config import load_config
     from sgdata.pipeline.generate import generate_dataset
@@ -55,13 +55,18 @@ def run_one(rooms: int, workers: int) -> dict:
 
         start = time.perf_counter()
         manifest = generate_dataset(
-            load_config(config_path), Path(tmp) / "data", workers=workers, progress=progress
+            load_config(config_path),
+            Path(tmp) / "data",
+            workers=workers,
+            executor=executor,
+            progress=progress,
         )
         wall = time.perf_counter() - start
     views = sum(manifest["counts"]["observations"].values())
     return {
         "rooms": rooms,
         "workers": workers,
+        "executor": executor,
         "views": views,
         "wall_s": round(wall, 2),
         "views_per_s": round(views / wall, 2),
@@ -75,17 +80,26 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rooms", type=int, nargs="+", default=[2, 4, 8])
     parser.add_argument("--workers", type=int, nargs="+", default=[1, 2])
+    parser.add_argument("--executor", default="local", choices=["local", "ray"])
     parser.add_argument("--one", nargs=2, type=int, help=argparse.SUPPRESS)  # rooms workers
     args = parser.parse_args()
     if args.one:
-        print(json.dumps(run_one(*args.one)))
+        print(json.dumps(run_one(*args.one, executor=args.executor)))
         return
     rows = []
     for rooms in args.rooms:
         for workers in args.workers:
             # a fresh process per measurement, so peak memory is that run's alone
             out = subprocess.run(
-                [sys.executable, __file__, "--one", str(rooms), str(workers)],
+                [
+                    sys.executable,
+                    __file__,
+                    "--one",
+                    str(rooms),
+                    str(workers),
+                    "--executor",
+                    args.executor,
+                ],
                 capture_output=True,
                 text=True,
                 check=True,

@@ -1,13 +1,18 @@
-"""Triplets per second: the SeanNet DataLoader against raw Parquet read + PNG decode.
+"""Triplets per second: the SeanNet DataLoader decoding PNG and reading the image cache.
 
     python bench/loader.py                  # generates the `tiny` preset into a temp dir
     python bench/loader.py --data out/tiny --size 112 --epochs 3 --threads 1
 
-The lower bound reads the image column of every observation shard of the split once and
-decodes the three images of every triplet (no resize, normalisation or graph tensors). The
-loader runs `DataLoader(TripletDataset, batch_size=8, collate_fn=collate_triplets)` with 0 and
-2 workers (persistent, so epochs after the first reuse the workers' shard caches); it prints
-the first (cold) epoch and the mean of the later (warm) ones, each as a ratio to the bound.
+Two raw reads bound the two loader paths. The PNG bound reads the image column of every
+observation shard of the split once and decodes the three images of every triplet; the cache
+bound copies the three cached (S, S, 3) uint8 views of every triplet out of the memory-mapped
+image cache (:mod:`seannet.image_cache`). Neither resizes, normalises or builds graph tensors.
+The loader runs `DataLoader(TripletDataset, batch_size=8, collate_fn=collate_triplets)` with 0
+and 2 workers (persistent, so epochs after the first reuse the workers' shard caches), once
+decoding PNG and once with ``cache=True``; it prints the first (cold) epoch and the mean of the
+later (warm) ones, each as a ratio to its path's bound, as one Markdown table. The cache is
+built (or found fresh) under ``<data>/.cache/images-<size>`` before timing, or in
+``--cache-dir``; its build time is printed apart.
 ``--threads`` sets the main process's torch threads (workers always use 1): on a small or
 busy machine, torch's intra-op pool can make collation (torch.stack) tens of times slower.
 """
@@ -20,6 +25,7 @@ import tempfile
 import time
 from pathlib import Path
 
+import numpy as np
 import pyarrow.parquet as pq
 import torch
 
@@ -29,6 +35,7 @@ sys.path.insert(0, str(ROOT))
 from torch.utils.data import DataLoader  # noqa: E402
 
 from seannet.data import ImageTransform, TripletDataset, collate_triplets  # noqa: E402
+from seannet.image_cache import open_image_cache  # noqa: E402
 from sgdata.dataset import Dataset, decode_image  # noqa: E402
 
 
@@ -55,12 +62,38 @@ def raw_epoch(root: Path, split: str) -> float:
     return time.perf_counter() - t0
 
 
+def raw_cache_epoch(root: Path, split: str, size: int, cache_dir: Path | None) -> float:
+    """Seconds to copy each triplet's three views out of the memory-mapped image cache.
+
+    Opening the cache (its freshness check) and reading the triplet table are not timed: the
+    bound is the reads alone, what every epoch of a loader over the cache must do.
+    """
+    ds = Dataset.open(root)
+    images = open_image_cache(ds, split, ImageTransform(size=size), cache_dir=cache_dir)
+    row = {obs: i for i, obs in enumerate(images.obs_ids)}
+    triplets = pq.read_table(ds.root / "triplets" / f"{split}.parquet")
+    rows = [
+        row[o] for n in ("anchor", "positive", "negative") for o in triplets.column(n).to_pylist()
+    ]
+    t0 = time.perf_counter()
+    array = np.load(images.path, mmap_mode="r")
+    for i in rows:
+        np.array(array[i])
+    return time.perf_counter() - t0
+
+
 def loader_epochs(
-    root: Path, split: str, size: int, workers: int, epochs: int, batch_size: int
+    root: Path,
+    split: str,
+    size: int,
+    workers: int,
+    epochs: int,
+    batch_size: int,
+    cache: bool | Path = False,
 ) -> list[float]:
     """Seconds per epoch of a DataLoader over a fresh TripletDataset."""
     t0 = time.perf_counter()
-    data = TripletDataset(root, split, transform=ImageTransform(size=size))
+    data = TripletDataset(root, split, transform=ImageTransform(size=size), cache=cache)
     loader = DataLoader(
         data,
         batch_size=batch_size,
@@ -86,6 +119,7 @@ def main() -> None:
     parser.add_argument("--epochs", type=int, default=3)
     parser.add_argument("--batch-size", type=int, default=8)
     parser.add_argument("--threads", type=int, default=1, help="main-process torch threads")
+    parser.add_argument("--cache-dir", type=Path, help="image cache dir (default: under --data)")
     args = parser.parse_args()
     torch.set_num_threads(args.threads)
 
@@ -104,20 +138,34 @@ def main() -> None:
         f"{args.threads} torch thread(s)"
     )
 
+    t0 = time.perf_counter()
+    open_image_cache(ds, args.split, ImageTransform(size=args.size), cache_dir=args.cache_dir)
+    print(f"image cache built or found fresh in {time.perf_counter() - t0:.2f} s")
+
     raw_epoch(root, args.split)  # warm the page cache
-    raw = min(raw_epoch(root, args.split) for _ in range(3))
-    bound = n / raw
-    print(f"{'raw Parquet read + PNG decode (bound)':<40} {bound:8.1f} triplets/s")
-    for workers in (0, 2):
-        times = loader_epochs(root, args.split, args.size, workers, args.epochs, args.batch_size)
-        cold = n / times[0]
-        label = f"DataLoader num_workers={workers}"
-        line = f"{label + ', epoch 1':<40} {cold:8.1f} triplets/s  ({cold / bound:.2f} x bound)"
-        print(line)
-        if len(times) > 1:
-            warm = n / (sum(times[1:]) / len(times[1:]))
-            label = f"{label}, epochs 2-{len(times)}"
-            print(f"{label:<40} {warm:8.1f} triplets/s  ({warm / bound:.2f} x bound)")
+    png_bound = n / min(raw_epoch(root, args.split) for _ in range(3))
+    raw_cache_epoch(root, args.split, args.size, args.cache_dir)
+    cache_bound = n / min(
+        raw_cache_epoch(root, args.split, args.size, args.cache_dir) for _ in range(3)
+    )
+    rows = [("raw Parquet read + PNG decode (PNG bound)", png_bound, 1.0)]
+    rows.append(("raw memmap read of the cache (cache bound)", cache_bound, 1.0))
+    for path, cache, bound in (
+        ("PNG", False, png_bound),
+        ("cache", args.cache_dir or True, cache_bound),
+    ):
+        for workers in (0, 2):
+            times = loader_epochs(
+                root, args.split, args.size, workers, args.epochs, args.batch_size, cache
+            )
+            label = f"DataLoader {path}, num_workers={workers}"
+            rows.append((f"{label}, epoch 1", n / times[0], n / times[0] / bound))
+            if len(times) > 1:
+                warm = n / (sum(times[1:]) / len(times[1:]))
+                rows.append((f"{label}, epochs 2-{len(times)}", warm, warm / bound))
+    print("\n| | triplets/s | / bound |\n|---|---|---|")
+    for label, rate, ratio in rows:
+        print(f"| {label} | {rate:.1f} | {ratio:.2f} |")
     if tmp is not None:
         tmp.cleanup()
 

@@ -1,7 +1,9 @@
-"""Views per second: bare pyrender passes (RGB, id) against the full view pipeline.
+"""Views per second: bare pyrender passes (RGB, id) against the full view pipeline, and
+plain pyrender (one node per object, an RGB and a SEG pass) on the same views.
 
     python bench/render.py --synthetic            # the tests' tiny room, runs today
-    python bench/render.py --rooms 2 --views 40   # generated rooms (sgdata.world.rooms + usd_io)
+    python bench/render.py --rooms 2 --views 40   # generated rooms (sgdata.world.rooms + usd)
+    LP_NUM_THREADS=1 python bench/render.py --rooms 4 --json   # one thread, machine-readable
     LP_NUM_THREADS=1 python bench/render.py --synthetic
 
 Prints frames per second of the RGB pass, the id pass, both (what the pipeline must do) and
@@ -12,6 +14,7 @@ bare passes (target >= 0.85).
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 import tempfile
 import time
@@ -26,6 +29,7 @@ sys.path.insert(0, str(ROOT))
 from sgdata.annotate.annotator import ViewAnnotator  # noqa: E402
 from sgdata.annotate.records import ViewPose  # noqa: E402
 from sgdata.annotate.slots import SlotTable  # noqa: E402
+from sgdata.render.camera import CameraConfig  # noqa: E402
 from sgdata.render.renderer import Renderer  # noqa: E402
 from sgdata.usd.meshes import SceneGeometry  # noqa: E402
 from sgdata.world.poses import pose_grid  # noqa: E402
@@ -72,6 +76,43 @@ def sample_poses(room: Room, count: int, rng: np.random.Generator) -> list[ViewP
     return poses
 
 
+class NaivePyrender:
+    """pyrender used as its documentation shows: the structure and one node per object (its
+    local mesh under its pose), two lights, an RGB pass and a SEG pass (instance colours)."""
+
+    def __init__(self, camera: CameraConfig, geometry: SceneGeometry) -> None:
+        import pyrender as pr
+
+        from sgdata.render.renderer import _ceiling_light_pose, _primitive
+
+        self.camera = camera
+        scene = pr.Scene(bg_color=[0.45, 0.45, 0.48, 1.0], ambient_light=[0.35] * 3)
+        seg = {}
+        for m in geometry.structure:
+            seg[scene.add(pr.Mesh([_primitive(pr, m, double_sided=True)]))] = np.zeros(3)
+        for k, obj in enumerate(geometry.objects, 1):
+            node = scene.add(pr.Mesh([_primitive(pr, obj.mesh)]), pose=np.asarray(obj.matrix))
+            seg[node] = np.array([k & 255, (k >> 8) & 255, k >> 16])
+        cam = pr.PerspectiveCamera(yfov=camera.yfov, aspectRatio=camera.width / camera.height)
+        self.cam_node = scene.add(cam)
+        scene.add(pr.DirectionalLight(color=np.ones(3), intensity=2.0), parent_node=self.cam_node)
+        scene.add(
+            pr.PointLight(color=np.ones(3), intensity=6.0), pose=_ceiling_light_pose(geometry)
+        )
+        self.scene, self.seg = scene, seg
+        self.gl = pr.OffscreenRenderer(camera.width, camera.height)
+        self.flags = pr.RenderFlags
+
+    def view(self, pose: ViewPose) -> tuple[np.ndarray, np.ndarray]:
+        self.scene.set_pose(self.cam_node, self.camera.pose_matrix(pose.x, pose.y, pose.theta))
+        rgb, _ = self.gl.render(self.scene)
+        ids, _ = self.gl.render(self.scene, flags=self.flags.SEG, seg_node_map=self.seg)
+        return rgb, ids
+
+    def close(self) -> None:
+        self.gl.delete()
+
+
 def rate(fn: Callable[[ViewPose], object], poses: list[ViewPose]) -> float:
     fn(poses[0])  # warm-up: shader compilation, buffer upload
     t = time.perf_counter()
@@ -87,6 +128,7 @@ def main() -> None:
     ap.add_argument("--views", type=int, default=40, help="views per room and measurement")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--id-pass", choices=["raster", "raycast"], default="raster")
+    ap.add_argument("--json", action="store_true", help="print one JSON line of the means")
     args = ap.parse_args()
 
     scenes = synthetic_scenes() if args.synthetic else generated_scenes(args.rooms, args.seed)
@@ -95,7 +137,8 @@ def main() -> None:
     renderer = Renderer(id_pass=args.id_pass)
     annotator = ViewAnnotator(renderer, slots)
     rng = np.random.default_rng(args.seed)
-    totals: dict[str, list[float]] = {"rgb": [], "ids": [], "rgb+ids": [], "pipeline": []}
+    keys = ("rgb", "ids", "rgb+ids", "pipeline", "naive")
+    totals: dict[str, list[float]] = {k: [] for k in keys}
     for room, geometry in scenes:
         annotator.set_layout(room, geometry, 0)
         poses = sample_poses(room, args.views, rng)
@@ -108,6 +151,9 @@ def main() -> None:
             "rgb+ids": rate(lambda p: renderer.render(p.x, p.y, p.theta), poses),
             "pipeline": rate(lambda p: annotator.view(p), poses),
         }
+        naive = NaivePyrender(renderer.camera, geometry)
+        fps["naive"] = rate(naive.view, poses)
+        naive.close()
         for key, value in fps.items():
             totals[key].append(value)
         objs = len(geometry.objects)
@@ -118,11 +164,12 @@ def main() -> None:
         )
     if totals["pipeline"]:
         mean = {k: float(np.mean(v)) for k, v in totals.items()}
-        print(
-            "mean: "
-            + " | ".join(f"{k} {v:.1f}/s" for k, v in mean.items())
-            + f" | pipeline / (rgb+ids) = {mean['pipeline'] / mean['rgb+ids']:.2f}"
-        )
+        mean["pipeline/naive"] = mean["pipeline"] / mean["naive"]
+        mean["pipeline/(rgb+ids)"] = mean["pipeline"] / mean["rgb+ids"]
+        if args.json:
+            print(json.dumps(mean))
+        else:
+            print("mean: " + " | ".join(f"{k} {v:.2f}" for k, v in mean.items()))
     renderer.close()
 
 

@@ -101,40 +101,43 @@ def evaluate(
 @app.command()
 def compare(
     data: Data,
-    out: Annotated[Path, typer.Option("--out", help="Directory for one run per model.")],
-    models: Annotated[str, typer.Option(help="Comma-separated models.")] = "seannet,resnet18",
+    out: Annotated[Path, typer.Option("--out", help="Directory for the runs and the tables.")],
+    models: Annotated[
+        str, typer.Option(help="Comma-separated models (seannet, seannet-graph, resnet18, ...).")
+    ] = "seannet,resnet18",
     preset: Annotated[str, typer.Option(help="cpu | paper")] = "cpu",
     split: Annotated[str, typer.Option(help="Split to compare on.")] = "test",
+    seeds: Annotated[str, typer.Option(help="Comma-separated training seeds.")] = "0",
+    lrs: Annotated[
+        str,
+        typer.Option(help="Candidate learning rates, chosen per model on val (default: preset)."),
+    ] = "",
+    budget: Annotated[
+        float | None, typer.Option(help="Training seconds per run (same for every model).")
+    ] = None,
 ) -> None:
-    """Train every model with the same preset and budget, evaluate, print one table."""
+    """Train every model under one budget, pick its lr on val, repeat over seeds, one table."""
     from seannet.compare import COMPARISON, compare_models
 
+    try:
+        seed_list = [int(s) for s in seeds.split(",") if s.strip()]
+        lr_list = [float(v) for v in lrs.split(",") if v.strip()]
+    except ValueError:
+        raise typer.BadParameter("--seeds takes integers, --lrs numbers, comma-separated") from None
     names = [m.strip() for m in models.split(",") if m.strip()]
-    rows = compare_models(data, out, names, preset=preset, split=split, announce=console.print)
-    table = Table(title=f"{split} split of {data}, preset {preset}")
-    for column in (
-        "model",
-        "triplet acc",
-        "tier 0",
-        "tier 1",
-        "tier 4",
-        "epsilon",
-        "precision",
-        "recall",
-    ):
-        table.add_column(column, justify="right")
-    for r in rows:
-        tiers = r["per_tier"]
-        table.add_row(
-            r["model"],
-            f"{100 * r['accuracy']:.1f} %",
-            *(f"{100 * tiers[k]:.1f} %" if k in tiers else "-" for k in (0, 1, 4)),
-            f"{r['threshold']['epsilon']:.3f}",
-            f"{r['threshold_on_split']['precision']:.3f}",
-            f"{r['threshold_on_split']['recall']:.3f}",
-        )
-    console.print(table)
-    console.print(f"wrote {out / COMPARISON}")
+    compare_models(
+        data,
+        out,
+        names,
+        preset=preset,
+        split=split,
+        seeds=seed_list,
+        lrs=lr_list,
+        budget_s=budget,
+        announce=console.print,
+    )
+    console.print((out / f"{COMPARISON}.md").read_text())
+    console.print(f"wrote {out / COMPARISON}.json and .md")
 
 
 @app.command()
@@ -151,6 +154,135 @@ def wordvectors(
 
     write_word_vectors(output, source=source)
     console.print(f"wrote {output}")
+
+
+Run = Annotated[Path, typer.Argument(help="Localizer run directory (holds best.pt).")]
+Epsilon = Annotated[
+    float | None,
+    typer.Option(help="Localization threshold (default: the run's eval_<split>.json epsilon)."),
+]
+
+
+@app.command(name="map")
+def build_map(
+    run: Run,
+    data: Data,
+    out: Annotated[Path, typer.Option("--out", help="Maps directory: one <room>/ per room.")],
+    split: Annotated[str, typer.Option(help="Map every room of this split.")] = "test",
+    room: Annotated[
+        list[str] | None, typer.Option(help="Map only these rooms (repeatable).")
+    ] = None,
+    layout: Annotated[int, typer.Option(help="Layout the map is built in.")] = 0,
+    spacing: Annotated[int, typer.Option(help="Cells between map nodes (the authors: 2).")] = 2,
+) -> None:
+    """Build topological maps (rendered sub-nodes + the run's embeddings), reused if present."""
+    from seannet.data import open_dataset
+    from seannet.localizer import load_localizer
+    from seannet.maps import build_maps
+
+    rooms = room or list(open_dataset(data).rooms(split))
+    localizer = load_localizer(run, data, require_epsilon=False)  # a map needs no epsilon
+    for path in build_maps(localizer, data, rooms, out, layout=layout, spacing=spacing):
+        console.print(f"map {path}")
+
+
+@app.command()
+def localize(
+    run: Run,
+    map_path: Annotated[Path, typer.Option("--map", help="A map directory, or a maps directory.")],
+    data: Data,
+    queries: Annotated[
+        list[str] | None, typer.Argument(help="Observation ids of --data to localize.")
+    ] = None,
+    split: Annotated[
+        str | None, typer.Option(help="Retrieval metrics on this split instead of queries.")
+    ] = None,
+    epsilon: Epsilon = None,
+    out: Annotated[Path | None, typer.Option(help="Where to write (default: the run).")] = None,
+) -> None:
+    """Best-matching map sub-nodes of queries, or recall@1/@5 on a split (other layouts)."""
+    from seannet.localize import run_localize
+
+    result = run_localize(
+        run, map_path, data, queries=queries or None, split=split, epsilon=epsilon, out=out
+    )
+    console.print(Path(result["written"]).read_text())
+    console.print(f"wrote {result['written']} and its .json")
+
+
+@app.command(name="train-navigator")
+def train_navigator_command(
+    data: Data,
+    out: Annotated[Path, typer.Option("--out", help="Run directory for the navigator.")],
+    epochs: Annotated[int, typer.Option(help="Epochs over the rendered pairs.")] = 10,
+    pairs: Annotated[int, typer.Option(help="Train pairs rendered from the train rooms.")] = 2000,
+    val_pairs: Annotated[int, typer.Option(help="Val pairs (best.pt by their accuracy).")] = 400,
+    image_size: Annotated[int, typer.Option(help="Navigator input size, pixels.")] = 96,
+    encoder: Annotated[str, typer.Option(help="Shared image encoder.")] = "resnet18",
+    batch_size: Annotated[int, typer.Option(help="Pairs per SGD step.")] = 32,
+    pretrained: Annotated[
+        Path | None, typer.Option(help="Local ImageNet weights of --encoder, sha256-checked.")
+    ] = None,
+    seed: Annotated[int, typer.Option(help="Seed of pairs, weights and batch order.")] = 0,
+) -> None:
+    """Train the visual navigator (forward / left / right) on pairs rendered from the rooms."""
+    from rich.progress import Progress
+
+    from seannet.navigator import NavigatorConfig
+    from seannet.navigator_train import train_navigator
+
+    config = NavigatorConfig(
+        encoder=encoder, image_size=image_size, epochs=epochs, batch_size=batch_size,
+        train_pairs=pairs, val_pairs=val_pairs, seed=seed,
+    )  # fmt: skip
+    with Progress(console=console, transient=True) as bar:
+        task = bar.add_task("render pairs", total=None)
+
+        def show(phase: str, step: int, total: int, metrics: dict[str, float]) -> None:
+            text = " ".join(f"{k} {v:.3f}" for k, v in metrics.items())
+            bar.update(task, description=f"{phase} {text}", completed=step, total=total)
+
+        history = train_navigator(config, data, out, pretrained=pretrained, progress=show)
+    table = Table(title=f"navigator on {data} -> {out}")
+    for column in ("epoch", "loss", "train acc", "val acc", "s"):
+        table.add_column(column, justify="right")
+    for h in history:
+        table.add_row(str(h["epoch"]), f"{h['train_loss']:.4f}", f"{h['train_accuracy']:.3f}",
+                      f"{h['val_accuracy']:.3f}", f"{h['seconds']:.0f}")  # fmt: skip
+    console.print(table)
+
+
+@app.command()
+def navigate(
+    runs: Annotated[list[Path], typer.Argument(help="Localizer run directories.")],
+    navigator: Annotated[Path, typer.Option("--navigator", help="train-navigator run.")],
+    data: Data,
+    split: Annotated[str, typer.Option(help="Rooms to test in.")] = "test",
+    episodes: Annotated[int, typer.Option(help="Episodes per case (N, A) and room.")] = 20,
+    seed: Annotated[int, typer.Option(help="Seed of the episodes.")] = 0,
+    spacing: Annotated[int, typer.Option(help="Cells between map nodes.")] = 2,
+    epsilon: Epsilon = None,
+    out: Annotated[
+        Path | None, typer.Option(help="Where to write (default: the navigator run).")
+    ] = None,
+    maps: Annotated[Path | None, typer.Option(help="Maps cache (default: OUT/maps).")] = None,
+    strips: Annotated[Path | None, typer.Option(help="Save a few episodes as strips.")] = None,
+) -> None:
+    """The navigation test (paper Table II): success and failure rates, N / A, per localizer."""
+    from seannet.navigate_run import HEADER, run_navigation, table_rows
+
+    with console.status("navigate") as status:
+        result = run_navigation(
+            runs, navigator, data, split=split, episodes=episodes, seed=seed, spacing=spacing,
+            epsilon=epsilon, out=out, maps=maps, strips=strips, progress=status.update,
+        )  # fmt: skip
+    table = Table(title=f"navigation on {split} of {data} ({episodes} episodes per case, room)")
+    for column in HEADER:
+        table.add_column(column, justify="right")
+    for row in table_rows(result):
+        table.add_row(*row)
+    console.print(table)
+    console.print(f"wrote {result['written']} and its .json")
 
 
 def _errors() -> tuple[type[Exception], ...]:

@@ -112,9 +112,39 @@ def preview(
 
 
 @app.command()
+def tag(
+    stage: Annotated[Path, typer.Argument(help="Your own USD room (never modified).")],
+    classes: Annotated[
+        Path | None,
+        typer.Option("--classes", help="TOML of non-catalog classes and their dynamics."),
+    ] = None,
+    output: Annotated[
+        Path | None,
+        typer.Option(
+            "-o", "--output", help="Tag layer to write (default: <stem>_sgdata/room.usda)."
+        ),
+    ] = None,
+) -> None:
+    """Write the sgdata:* attributes your own USD room lacks as a layer over it."""
+    from sgdata.usd.tagging import tag_stage
+
+    report = tag_stage(stage, classes=classes, output=output)
+    room = report.room
+    console.print(
+        f"wrote {report.output} over {report.source}: {room.width:.2f} x {room.depth:.2f} x "
+        f"{room.height:.2f} m, {len(room.objects)} objects, door on the {room.door.wall} wall",
+        markup=False,
+    )
+    for line in report.inferred:
+        console.print(f"  inferred {line}", markup=False)
+    for line in (*report.problems, *report.usd_problems):
+        console.print(f"  warning: {line}", markup=False)
+
+
+@app.command()
 def generate(
     config: Annotated[
-        str, typer.Argument(help="Config TOML file, or a preset: tiny | small | paper.")
+        str, typer.Argument(help="Config TOML file, or a preset: tiny | small | medium | paper.")
     ],
     out: Annotated[Path, typer.Argument(help="Dataset root directory.")],
     workers: Annotated[
@@ -311,6 +341,76 @@ def label(
         port=port,
         class_map=classes,
         on_ready=lambda url: console.print(f"labeling {photos} at {url} (Ctrl-C stops)"),
+    )
+
+
+@app.command(name="import")
+def import_(
+    fmt: Annotated[str, typer.Argument(metavar="FORMAT", help="coco | labelme | labelstudio")],
+    annotations: Annotated[
+        Path, typer.Argument(metavar="FILE", help="The annotation file (LabelMe: or a folder).")
+    ],
+    images: Annotated[Path, typer.Option("--images", help="Directory of the annotated photos.")],
+    out: Annotated[Path, typer.Option("--out", help="Dataset directory (labels/ is kept there).")],
+    classes: Annotated[
+        Path | None,
+        typer.Option("--classes", help="TOML mapping names to catalog classes (+ [relations])."),
+    ] = None,
+    room: Annotated[
+        str | None,
+        typer.Option(help="Room id of photos the file gives none (default: FILE's name)."),
+    ] = None,
+    room_type: Annotated[
+        str | None,
+        typer.Option(
+            help="kitchen | living_room | bedroom | bathroom (default: from the room id)."
+        ),
+    ] = None,
+    split: Annotated[str, typer.Option(help="Split of the imported rooms.")] = "test",
+) -> None:
+    """Import COCO, LabelMe or Label Studio boxes (and relations) as labels and a real dataset."""
+    from sgdata.label.importers import import_labels
+
+    done = import_labels(
+        fmt,
+        annotations,
+        images,
+        out,
+        class_map=classes,
+        room=room,
+        room_type=room_type,
+        split=split,
+    )
+    ex = done.export
+    console.print(
+        f"imported {done.boxes} box(es) and {done.relations} relation(s) of {done.photos} "
+        f"photo(s); wrote {ex.observations} observation(s) of {ex.rooms} room(s) and "
+        f"{ex.triplets} triplet(s) to {ex.root} (split {ex.split})"
+    )
+    for note in [*done.notes, *ex.notes]:
+        console.print(note, markup=False)
+
+
+@app.command(name="export")
+def export(
+    fmt: Annotated[str, typer.Argument(metavar="FORMAT", help="labelstudio")],
+    dataset: Annotated[Path, typer.Argument(help="Dataset root (holding dataset.json).")],
+    output: Annotated[Path, typer.Option("-o", "--output", help="Label Studio JSON to write.")],
+    images: Annotated[
+        Path | None,
+        typer.Option("--images", help="Where the images go (default: <output stem>_images/)."),
+    ] = None,
+) -> None:
+    """Write a dataset's boxes and relations as Label Studio JSON, and its images as files."""
+    from sgdata.errors import ConfigError
+    from sgdata.label.labelstudio import export_labelstudio
+
+    if fmt != "labelstudio":
+        raise ConfigError(f"format {fmt!r}: expected labelstudio")
+    done = export_labelstudio(dataset, output, images_dir=images)
+    console.print(
+        f"wrote {done.tasks} task(s), {done.boxes} box(es) and {done.relations} relation(s) "
+        f"to {done.path}; images in {done.images}"
     )
 
 

@@ -19,15 +19,18 @@ class ImageEncoder(nn.Module):
     The paper compares SeanNet with ResNet-50, ResNeXt-50, VGG-16 and GoogLeNet trained with
     the same triplet loss (https://arxiv.org/abs/2110.02276, §V-C). The network's classifier is
     dropped (see :func:`seannet.backbones.image_encoder`); where its native feature width
-    differs from ``embed_dim`` (ResNet-18/34: 512, GoogLeNet: 1024, VGG-16: 4096), one linear
+    differs from ``embed_dim`` (ResNet-18/34: 512, GoogLeNet: 1024, EfficientNet-Lite0: 1280,
+    VGG-16: 4096), one linear
     layer projects it to ``embed_dim``, so every model's embedding is the same size and the
     same similarity threshold analysis applies. ResNet-50 and ResNeXt-50 (2048) are used as is.
 
     Args:
-        name: ``"resnet18"``, ``"resnet34"``, ``"resnet50"``, ``"resnext50"``, ``"vgg16"``
-            or ``"googlenet"``.
+        name: ``"resnet18"``, ``"resnet34"``, ``"resnet50"``, ``"resnext50"``, ``"vgg16"``,
+            ``"googlenet"`` or ``"efficientnet_lite0"`` (the optional ``lite`` extra).
         embed_dim: width of the embedding (default 2048, as SeanNet's).
-        pretrained: a local torchvision state_dict for the network (default: random init).
+        pretrained: a local torchvision state_dict for the network (default: random init);
+            for ``efficientnet_lite0`` also ``"imagenet-lite0"``, the ImageNet weights the
+            ``lite`` extra installs.
         pretrained_sha256: its expected SHA-256 (default: torchvision's known weights).
 
     Shapes:
@@ -40,7 +43,7 @@ class ImageEncoder(nn.Module):
         name: str,
         *,
         embed_dim: int = 2048,
-        pretrained: Path | None = None,
+        pretrained: str | Path | None = None,
         pretrained_sha256: str | None = None,
     ) -> None:
         super().__init__()

@@ -1,49 +1,207 @@
-"""``seannet compare``: train every model with one preset and budget, evaluate, one table."""
+"""``seannet compare``: train every model under one wall-clock budget, pick each model's
+learning rate on the validation rooms, repeat over seeds, and report mean +- std and a 95 %
+interval per model.
+
+Fairness, as measured rather than assumed: every model gets the same *seconds* of training
+(not the same number of batches), calibrated once per model by timing a few training steps;
+the batch count that budget buys is recorded, so a rerun with the recorded figures trains
+exactly the same. The learning rate of each model is the best of ``lrs`` on the validation
+split (seed 0), and the seeds reuse it.
+"""
 
 from __future__ import annotations
 
 import json
-from collections.abc import Callable
+import math
+import time
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+import torch
+from scipy import stats
+from torch.utils.data import DataLoader
+
+from seannet.config import TrainConfig
 from seannet.config import preset as load_preset
+from seannet.data import ImageTransform, TripletDataset, collate_triplets
 from seannet.errors import ModelError
 from seannet.eval_run import evaluate_run
-from seannet.train import LAST, train
+from seannet.loss import TripletLoss
+from seannet.train import HISTORY, LAST, build_for_dataset, param_groups, train
 from sgdata.fileio import atomic_write_text
 
-__all__ = ["COMPARISON", "compare_models"]
+__all__ = ["COMPARISON", "compare_models", "calibrate_batches", "summarize"]
 
-COMPARISON = "comparison.json"  # the results, one entry per model, under the output directory
+COMPARISON = "comparison"  # comparison.json and comparison.md under the output directory
+_CALIBRATION_STEPS = 3  # timed training steps (after one warm-up) per model
 
 
 def compare_models(
     data: Path,
     out: Path,
-    models: list[str],
+    models: Sequence[str],
     *,
-    preset: str = "cpu",
+    preset: str | TrainConfig = "cpu",
     split: str = "test",
+    seeds: Sequence[int] = (0,),
+    lrs: Sequence[float] = (),
+    budget_s: float | None = None,
     announce: Callable[[str], None] | None = None,
-) -> list[dict[str, Any]]:
-    """Train (or resume) one run per model under ``out/<model>``, evaluate each on ``split``.
+) -> dict[str, Any]:
+    """Train and evaluate every model; write ``out/comparison.{json,md}`` and return it.
 
-    A run that already has a checkpoint resumes from it, so an interrupted comparison picks up
-    where it stopped. Writes ``out/comparison.json`` atomically and returns its entries.
+    Runs live in ``out/<model>/lr<lr>/seed<k>``; a run that has a checkpoint resumes, so an
+    interrupted comparison picks up where it stopped.
+
+    Args:
+        preset: a preset name or a :class:`TrainConfig` (its ``model`` is replaced).
+        seeds: training seeds; each model's figures are their mean, std and 95 % interval.
+        lrs: candidate learning rates, chosen per model on ``val`` (default: the preset's).
+        budget_s: training seconds per run; None keeps the preset's batch count for all.
 
     Raises:
-        ModelError: no model named.
+        ModelError: no model or no seed named.
     """
-    if not models:
-        raise ModelError("--models is empty: name at least one model, e.g. seannet,resnet18")
-    rows = []
+    if not models or not seeds:
+        raise ModelError("name at least one model (--models) and one seed (--seeds)")
+    say = announce or (lambda _text: None)
+    base = load_preset(preset) if isinstance(preset, str) else preset
+    name_of_preset = preset if isinstance(preset, str) else "custom"
+    results: dict[str, Any] = {"preset": name_of_preset, "split": split, "budget_s": budget_s}
+    entries = []
     for name in models:
-        run = out / name
-        config = load_preset(preset).replace(model=name)
-        if announce is not None:
-            announce(f"training {name} ({preset} preset) -> {run}")
-        train(config, data, run, resume=(run / LAST).exists())
-        rows.append(evaluate_run(run, data, split=split))
-    atomic_write_text(out / COMPARISON, json.dumps(rows, indent=2))
-    return rows
+        config = base.replace(model=name)
+        if budget_s is not None:
+            batches = calibrate_batches(config, data, budget_s)
+            config = config.replace(max_train_batches=batches)
+            say(f"{name}: {batches} batches per epoch fill {budget_s:.0f} s")
+        sweep = {}
+        for lr in lrs or (config.lr,):
+            run = _run_dir(out, name, lr, seeds[0])
+            say(f"{name}: lr {lr:g}, seed {seeds[0]} -> {run}")
+            _train(config.replace(lr=lr, seed=seeds[0]), data, run)
+            sweep[lr] = max(h["val_accuracy"] for h in json.loads((run / HISTORY).read_text()))
+        lr = max(sweep, key=lambda k: (sweep[k], -k))  # best val accuracy; ties: the smaller
+        runs = []
+        for seed in seeds:
+            run = _run_dir(out, name, lr, seed)
+            if seed != seeds[0]:
+                say(f"{name}: lr {lr:g}, seed {seed} -> {run}")
+                _train(config.replace(lr=lr, seed=seed), data, run)
+            runs.append(evaluate_run(run, data, split=split))
+        entries.append(
+            {
+                "model": name,
+                "lr": lr,
+                "val_accuracy_by_lr": {f"{k:g}": v for k, v in sweep.items()},
+                "batches_per_epoch": config.max_train_batches,
+                "epochs": config.epochs,
+                "summary": summarize(runs),
+                "runs": runs,
+            }
+        )
+    results["models"] = entries
+    out.mkdir(parents=True, exist_ok=True)
+    atomic_write_text(out / f"{COMPARISON}.json", json.dumps(results, indent=2))
+    atomic_write_text(out / f"{COMPARISON}.md", markdown(results))
+    return results
+
+
+def _run_dir(out: Path, name: str, lr: float, seed: int) -> Path:
+    return out / name / f"lr{lr:g}" / f"seed{seed}"
+
+
+def _train(config: TrainConfig, data: Path, run: Path) -> None:
+    train(config, data, run, resume=(run / LAST).exists())
+
+
+def calibrate_batches(config: TrainConfig, data: Path, budget_s: float) -> int:
+    """Batches per epoch that fill ``budget_s`` seconds of training, from timed steps."""
+    torch.manual_seed(0)
+    model = build_for_dataset(config, data)
+    optimizer = torch.optim.SGD(param_groups(model, config), lr=config.lr, momentum=0.9)
+    loss_fn = TripletLoss(margin=config.margin)
+    triplets = TripletDataset(data, "train", transform=ImageTransform(size=config.image_size))
+    loader = iter(DataLoader(triplets, batch_size=config.batch_size, collate_fn=collate_triplets))
+    model.train()
+    seconds = []
+    for step in range(_CALIBRATION_STEPS + 1):
+        a, p, n, _ = next(loader)
+        start = time.perf_counter()
+        loss = loss_fn(model.embed(a), model.embed(p), model.embed(n))
+        optimizer.zero_grad()
+        loss.backward()
+        optimizer.step()
+        if step:  # the first step pays for allocation
+            seconds.append(time.perf_counter() - start)
+    per_epoch = budget_s / config.epochs
+    return max(1, int(per_epoch / float(np.median(seconds))))
+
+
+def _interval(values: list[float]) -> dict[str, float]:
+    """Mean, std (ddof 1) and the half-width of a 95 % t interval of the mean."""
+    x = np.asarray(values, dtype=np.float64)
+    n = len(x)
+    std = float(x.std(ddof=1)) if n > 1 else float("nan")
+    half = float(stats.t.ppf(0.975, n - 1) * std / math.sqrt(n)) if n > 1 else float("nan")
+    return {"mean": float(x.mean()), "std": std, "ci95": half, "n": n}
+
+
+def summarize(runs: list[dict[str, Any]]) -> dict[str, Any]:
+    """Per-metric mean / std / 95 % interval over the seeds' evaluation results."""
+    first = runs[0]
+    summary = {
+        "accuracy": _interval([r["accuracy"] for r in runs]),
+        "recall1": _interval([r["retrieval"]["recall"][1] for r in runs]),
+        "recall5": _interval([r["retrieval"]["recall"][5] for r in runs]),
+        "d_prime": _interval([r["separation"]["d_prime"] for r in runs]),
+        "per_tier": {
+            str(k): _interval([r["per_tier"][k] for r in runs]) for k in first["per_tier"]
+        },
+        "by_moved": {
+            k: _interval([r["by_moved"][k]["accuracy"] for r in runs]) for k in first["by_moved"]
+        },
+        "triplets": first["triplets"],
+        "rooms": len(first["per_room"]),
+        "queries": first["retrieval"]["queries"],
+    }
+    p, n = summary["accuracy"]["mean"], summary["triplets"]
+    # the sampling interval of one run's accuracy over its triplets (binomial)
+    summary["accuracy"]["binomial95"] = 1.96 * math.sqrt(p * (1 - p) / n) if n else float("nan")
+    return summary
+
+
+def _pm(entry: dict[str, float]) -> str:
+    mean, ci = 100 * entry["mean"], 100 * entry["ci95"]
+    return f"{mean:.1f} ± {ci:.1f}" if not math.isnan(ci) else f"{mean:.1f}"
+
+
+def markdown(results: dict[str, Any]) -> str:
+    """The comparison as markdown tables (mean ± 95 % interval over seeds, in %)."""
+    rows = [
+        f"# Comparison on {results['split']} (preset {results['preset']}, "
+        f"budget {results['budget_s']} s per run)",
+        "",
+        "| model | lr | seeds | triplet acc | recall@1 | recall@5 | tier 0 | tier 1 | d' | "
+        "triplets / rooms |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for e in results["models"]:
+        s = e["summary"]
+        tiers = s["per_tier"]
+        rows.append(
+            f"| {e['model']} | {e['lr']:g} | {s['accuracy']['n']} | {_pm(s['accuracy'])} | "
+            f"{_pm(s['recall1'])} | {_pm(s['recall5'])} | "
+            f"{_pm(tiers['0']) if '0' in tiers else '-'} | "
+            f"{_pm(tiers['1']) if '1' in tiers else '-'} | "
+            f"{s['d_prime']['mean']:.2f} | {s['triplets']} / {s['rooms']} |"
+        )
+    rows += ["", "Accuracy by moved objects in view (mean over seeds, %):", ""]
+    bins = list(results["models"][0]["summary"]["by_moved"]) if results["models"] else []
+    rows += ["| model | " + " | ".join(bins) + " |", "|---|" + "---|" * len(bins)]
+    for e in results["models"]:
+        moved = e["summary"]["by_moved"]
+        rows.append(f"| {e['model']} | " + " | ".join(_pm(moved[b]) for b in bins) + " |")
+    return "\n".join(rows) + "\n"

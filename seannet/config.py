@@ -21,11 +21,16 @@ class TrainConfig:
     depth: int = 50  # SeanNet's ResNet depth (18 / 34 / 50)
     image_size: int = 224  # square input size; boxes are scaled with the image
     roi_size: int = 14  # RoIAlign output; 14 on the 14 x 14 C4 map of a 224 input
+    # SeanNet's x_v: "c4_head" (the paper: the head on every RoI crop) or "c5" (RoIAlign on
+    # the 5th-stage map computed once per image: no head pass per object)
+    visual_features: str = "c4_head"
     embed_dim: int = 2048
     dropout: float = 0.2  # on the GCN layers (paper §V-B)
     epochs: int = 60
     batch_size: int = 14  # the paper's SeanNet batch
     lr: float = 0.01  # SGD (paper §V-B)
+    # learning rate of the layers SeanNet adds (object fcn, GCN, fusion) relative to ``lr``
+    new_layers_lr_scale: float = 1.0
     momentum: float = 0.9
     lr_decay: float = 0.7  # x0.7 ...
     decay_every: int = 10  # ... every 10 epochs
@@ -39,10 +44,18 @@ class TrainConfig:
         for name in positive:
             if getattr(self, name) < 1:
                 raise ModelError(f"train.{name} must be >= 1, got {getattr(self, name)}")
+        if self.visual_features not in ("c5", "c4_head"):
+            raise ModelError(
+                f"train.visual_features {self.visual_features!r}: expected 'c5' or 'c4_head'"
+            )
         if self.depth not in (18, 34, 50):
             raise ModelError(f"train.depth {self.depth}: expected 18, 34 or 50")
         if not 0.0 <= self.dropout < 1.0:
             raise ModelError(f"train.dropout must be within [0, 1), got {self.dropout}")
+        if self.new_layers_lr_scale <= 0:
+            raise ModelError(
+                f"train.new_layers_lr_scale must be > 0, got {self.new_layers_lr_scale}"
+            )
         if self.lr <= 0 or self.margin < 0 or self.decay_every < 1 or self.num_workers < 0:
             raise ModelError("train: lr > 0, margin >= 0, decay_every >= 1, num_workers >= 0")
 
@@ -66,6 +79,10 @@ PRESETS: dict[str, TrainConfig] = {
         depth=18,
         image_size=112,
         roi_size=7,
+        visual_features="c5",
+        # with 1 the GCN pathways moved ~10x less than the backbone in the first batches
+        # (bench/branch_motion.py); 10 brings object fcn, GCN and fusion to its order
+        new_layers_lr_scale=10.0,
         epochs=5,
         batch_size=16,
         decay_every=2,

@@ -10,6 +10,10 @@ The reader side of the on-disk format (docs/dataset.md) for training and evaluat
   :class:`~seannet.batch.SceneBatch` objects for ``torch.utils.data.DataLoader``.
 - :func:`dataset_identity` names the data a model was trained on, for checkpoints.
 
+With ``cache=True`` (or a cache directory) the datasets read images from the decoded-image
+cache of :mod:`seannet.image_cache` (built on first use, rebuilt when stale) instead of
+decoding PNG per view; the tensors are the same either way.
+
 Files are opened lazily in each process that reads (``DataLoader`` workers included): a
 dataset object holds only plain Python and numpy state until its first item is read, and the
 per-process cache is keyed by ``os.getpid()`` so nothing read before a fork is reused after it.
@@ -34,6 +38,7 @@ from torch.utils.data import Dataset as TorchDataset
 
 from seannet.batch import NUM_RELATIONS, SceneBatch
 from seannet.errors import DataError
+from seannet.image_cache import CachedImages, open_image_cache
 from seannet.view_inputs import (
     IMAGENET_MEAN,
     IMAGENET_STD,
@@ -62,7 +67,7 @@ __all__ = [
     "open_dataset",
 ]
 
-# Observation columns a view needs: the encoded image and the scene graph.
+# Observation columns a view needs: the encoded image and the scene graph (image first).
 _VIEW_COLUMNS = ("image", "objects", "relations")
 # Observation columns kept per view for evaluation (ObservationItem).
 _META_COLUMNS = ("obs_id", "room_id", "layout", "grid_i", "grid_j", "heading")
@@ -178,16 +183,20 @@ class ObservationItem:
 class _Shard:
     """One observation file's view columns, held as Arrow / numpy in one process.
 
-    Images stay encoded (PNG/JPEG bytes in the Arrow column) and are decoded on access; the
-    scene graphs are flattened once into numpy columns with per-row offsets.
+    Images stay encoded (PNG/JPEG bytes in the Arrow column) and are decoded on access, or
+    are not read at all (``with_images=False``, when the image cache serves them); the scene
+    graphs are flattened once into numpy columns with per-row offsets, and each row's graph
+    tensors are kept once computed (``graphs``: a few KB a view, the largest per-view cost
+    after PNG decoding).
     """
 
-    def __init__(self, path: Path) -> None:
+    def __init__(self, path: Path, *, with_images: bool = True) -> None:
+        columns = _VIEW_COLUMNS if with_images else _VIEW_COLUMNS[1:]
         try:
-            table = read_table(path, observations_schema(), columns=_VIEW_COLUMNS)
+            table = read_table(path, observations_schema(), columns=columns)
         except DatasetError as exc:
             raise DataError(_one_line(str(exc))) from None
-        self.images = table.column("image")
+        self.images = table.column("image") if with_images else None
         self.obj_offsets, obj = _flatten_lists(
             table.column("objects"), ("instance", "class_id", "slot", "box2d")
         )
@@ -199,6 +208,28 @@ class _Shard:
             obj["box2d"],
         )
         self.src, self.dst, self.type = rel["src"], rel["dst"], rel["type"]
+        self.graphs: list[tuple[Tensor, ...] | None] = [None] * (len(self.obj_offsets) - 1)
+
+    def graph(self, row: int, num_slots: int) -> tuple[Tensor, ...]:
+        """Row ``row``'s :func:`graph_from_columns` tensors, computed on first use.
+
+        Callers must not modify them in place (:meth:`_ViewStore.view` hands out copies).
+        """
+        graph = self.graphs[row]
+        if graph is None:
+            o0, o1 = self.obj_offsets[row], self.obj_offsets[row + 1]
+            r0, r1 = self.rel_offsets[row], self.rel_offsets[row + 1]
+            graph = self.graphs[row] = graph_from_columns(
+                self.instance[o0:o1],
+                self.class_id[o0:o1],
+                self.slot[o0:o1],
+                self.box2d[o0:o1],
+                self.src[r0:r1],
+                self.dst[r0:r1],
+                self.type[r0:r1],
+                num_slots,
+            )
+        return graph
 
 
 def _flatten_lists(
@@ -218,7 +249,13 @@ class _ViewStore:
     for a view (``os.getpid()`` keys the cache, so a fork never reuses the parent's).
     """
 
-    def __init__(self, ds: Dataset, split: str, transform: ImageTransform) -> None:
+    def __init__(
+        self,
+        ds: Dataset,
+        split: str,
+        transform: ImageTransform,
+        images: CachedImages | None = None,
+    ) -> None:
         self.split = split
         self.transform = transform
         self.num_slots = int(ds.manifest.num_slots)
@@ -238,6 +275,12 @@ class _ViewStore:
             raise DataError(f"split {split!r}: an obs_id repeats across its observation shards")
         self._pid: int | None = None
         self._shards: dict[int, _Shard] = {}
+        self.cached = images
+        if images is not None and images.obs_ids != self.obs_ids:
+            raise DataError(
+                f"image cache {images.path}: its views are not split {split!r}'s; delete it "
+                "to rebuild"
+            )
 
     def __getstate__(self) -> dict[str, Any]:
         state = dict(self.__dict__)
@@ -258,30 +301,34 @@ class _ViewStore:
             self._pid, self._shards = pid, {}
         shard = self._shards.get(f)
         if shard is None:
-            shard = self._shards[f] = _Shard(Path(self.files[f]))
+            shard = self._shards[f] = _Shard(Path(self.files[f]), with_images=self.cached is None)
         return shard
 
     def view(self, f: int, row: int) -> ViewTensors:
         s = self.shard(f)
-        o0, o1 = s.obj_offsets[row], s.obj_offsets[row + 1]
-        r0, r1 = s.rel_offsets[row], s.rel_offsets[row + 1]
         obs = self.obs_ids_of(f, row)
         try:
-            slots, class_ids, boxes, edge_index, edge_weight = graph_from_columns(
-                s.instance[o0:o1],
-                s.class_id[o0:o1],
-                s.slot[o0:o1],
-                s.box2d[o0:o1],
-                s.src[r0:r1],
-                s.dst[r0:r1],
-                s.type[r0:r1],
-                self.num_slots,
-            )
-            rgb = decode_image(s.images[row].as_py())
+            slots, class_ids, boxes, edge_index, edge_weight = s.graph(row, self.num_slots)
+            if self.cached is None:
+                rgb, box = decode_image(s.images[row].as_py()), boxes.numpy()  # type: ignore[index]
+            else:
+                at = int(self.file_starts[f]) + row
+                h, w = self.cached.source_hw[at]
+                rgb, box = self.cached.image(at), self._scaled_boxes(int(h), int(w), boxes.numpy())
         except (DataError, DatasetError) as exc:
             raise DataError(f"observation {obs!r}: {exc}") from None
-        image, boxes = self.transform(rgb, boxes.numpy())
+        image, boxes = self.transform(rgb, box)  # new boxes: the kept ones stay untouched
+        kept = (class_ids, slots, edge_index, edge_weight)
+        class_ids, slots, edge_index, edge_weight = (t.clone() for t in kept)
         return ViewTensors(image, boxes, class_ids, slots, edge_index, edge_weight, self.num_slots)
+
+    def _scaled_boxes(self, h: int, w: int, boxes: np.ndarray) -> np.ndarray:
+        """Boxes of a cached view scaled from its decoded h x w frame to the cached one, with
+        ImageTransform's factors and float32 arithmetic (the transform then leaves a view
+        already at its size, and its boxes, as they are)."""
+        s = self.transform.size
+        scale = np.asarray([s / w, s / h, s / w, s / h], dtype=np.float32)
+        return np.asarray(boxes, dtype=np.float32).reshape(-1, 4) * scale
 
     def obs_ids_of(self, f: int, row: int) -> str:
         return self.obs_ids[int(self.file_starts[f]) + row]
@@ -303,6 +350,7 @@ def _open_split(
     root: str | Path,
     split: str,
     transform: ImageTransform | None,
+    cache: bool | str | Path,
 ) -> Dataset:
     """The attributes both datasets share: root, split, transform, identity and view store."""
     ds = open_dataset(root)
@@ -310,7 +358,11 @@ def _open_split(
     target.split = split
     target.transform = transform or ImageTransform()
     target.identity = dataset_identity(ds)
-    target._store = _ViewStore(ds, split, target.transform)
+    images = None
+    if cache is not False and cache is not None:
+        cache_dir = None if cache is True else Path(cache)
+        images = open_image_cache(ds, split, target.transform, cache_dir=cache_dir)
+    target._store = _ViewStore(ds, split, target.transform, images)
     return ds
 
 
@@ -321,23 +373,34 @@ class TripletDataset(TorchDataset):
     observation shards (to index every view by id, and to check every triplet's views
     exist). Each process that reads items (the main one, or each ``DataLoader`` worker) loads
     the image, objects and relations columns of a room shard on its first view from it and
-    keeps them (images still encoded) for later items; images are decoded per item. Memory
-    per reading process is therefore about the size of the split's observation files.
+    keeps them (images still encoded) for later items; images are decoded per item, or read
+    from the memory-mapped image cache with ``cache``. Memory per reading process is therefore
+    about the size of the split's observation files (plus the cache pages it touches, shared
+    between processes through the page cache).
 
     Args:
         root: the dataset directory.
         split: ``train``, ``val`` or ``test``.
         transform: image size and normalisation (default 224 px, ImageNet statistics).
+        cache: read images from the decoded-image cache (:mod:`seannet.image_cache`) instead
+            of decoding PNG per view: ``True`` for the default cache dir under the dataset
+            root, or a directory of the caller's; built on first use, rebuilt when stale.
+            Default ``False`` (decode per view).
 
     Raises:
-        DataError: the dataset or split is missing or malformed, or a triplet names an
-            observation the split does not hold.
+        DataError: the dataset or split is missing or malformed, a triplet names an
+            observation the split does not hold, or the image cache cannot be used.
     """
 
     def __init__(
-        self, root: str | Path, split: str, *, transform: ImageTransform | None = None
+        self,
+        root: str | Path,
+        split: str,
+        *,
+        transform: ImageTransform | None = None,
+        cache: bool | str | Path = False,
     ) -> None:
-        ds = _open_split(self, root, split, transform)
+        ds = _open_split(self, root, split, transform, cache)
         table = _call(ds.triplets, split)
         self.triplet_ids = table.column("triplet_id").to_numpy().astype(np.int64)
         self.tiers = table.column("tier").to_numpy().astype(np.int64)
@@ -381,15 +444,22 @@ class ObservationDataset(TorchDataset):
         root: the dataset directory.
         split: ``train``, ``val`` or ``test``.
         transform: image size and normalisation (default 224 px, ImageNet statistics).
+        cache: as for :class:`TripletDataset` (default ``False``: decode per view).
 
     Raises:
-        DataError: the dataset or split is missing or malformed.
+        DataError: the dataset or split is missing or malformed, or the image cache cannot
+            be used.
     """
 
     def __init__(
-        self, root: str | Path, split: str, *, transform: ImageTransform | None = None
+        self,
+        root: str | Path,
+        split: str,
+        *,
+        transform: ImageTransform | None = None,
+        cache: bool | str | Path = False,
     ) -> None:
-        _open_split(self, root, split, transform)
+        _open_split(self, root, split, transform, cache)
 
     def __len__(self) -> int:
         return len(self._store.obs_ids)

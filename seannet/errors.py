@@ -2,7 +2,14 @@
 
 from __future__ import annotations
 
-__all__ = ["SeannetError", "ModelError", "CheckpointError", "DataError"]
+__all__ = [
+    "SeannetError",
+    "ModelError",
+    "CheckpointError",
+    "DataError",
+    "MapError",
+    "NavigationError",
+]
 
 
 class SeannetError(Exception):
@@ -19,3 +26,11 @@ class CheckpointError(SeannetError):
 
 class DataError(SeannetError):
     """Model input is malformed: a batch, a dataset record or the word-vector table."""
+
+
+class MapError(SeannetError):
+    """A topological map is missing, malformed, or belongs to another run or dataset."""
+
+
+class NavigationError(SeannetError):
+    """A localization or navigation request cannot run: no threshold, no room, no episode."""

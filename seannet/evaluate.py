@@ -34,9 +34,11 @@ __all__ = [
     "embed_split",
     "example_groups",
     "offset_statistics",
+    "pose_pairs",
     "similarity_of",
     "threshold_quality",
     "triplet_metrics",
+    "triplet_similarities",
 ]
 
 MAX_OFFSET = 4
@@ -90,15 +92,21 @@ def embed_split(
     )
 
 
-def triplet_metrics(embeddings: Embeddings, triplets: TripletDataset) -> dict[str, Any]:
-    """Accuracy overall, per room and per tier, from the split's embeddings."""
+def triplet_similarities(
+    embeddings: Embeddings, triplets: TripletDataset
+) -> tuple[np.ndarray, np.ndarray]:
+    """(S(A, P), S(A, N)) of every triplet, from the split's embeddings."""
     index = embeddings.index()
     v = embeddings.vectors
-    a = np.array([index[t[0]] for t in triplets.obs])
-    p = np.array([index[t[1]] for t in triplets.obs])
-    n = np.array([index[t[2]] for t in triplets.obs])
-    s_ap = np.einsum("ij,ij->i", v[a], v[p])
-    s_an = np.einsum("ij,ij->i", v[a], v[n])
+    a = np.array([index[t[0]] for t in triplets.obs], dtype=np.int64)
+    p = np.array([index[t[1]] for t in triplets.obs], dtype=np.int64)
+    n = np.array([index[t[2]] for t in triplets.obs], dtype=np.int64)
+    return np.einsum("ij,ij->i", v[a], v[p]), np.einsum("ij,ij->i", v[a], v[n])
+
+
+def triplet_metrics(embeddings: Embeddings, triplets: TripletDataset) -> dict[str, Any]:
+    """Accuracy overall, per room and per tier, from the split's embeddings."""
+    s_ap, s_an = triplet_similarities(embeddings, triplets)
     correct = s_ap > s_an
     rooms = np.array(triplets.room_ids)
     tiers = np.asarray(triplets.tiers)
@@ -155,7 +163,7 @@ def offset_statistics(embeddings: Embeddings) -> dict[str, Any]:
     return {"mean": mean, "std": std, "count": count}
 
 
-def _pose_pairs(embeddings: Embeddings) -> tuple[np.ndarray, np.ndarray]:
+def pose_pairs(embeddings: Embeddings) -> tuple[np.ndarray, np.ndarray]:
     """Similarities of same-pose pairs and of one-step pairs (same heading)."""
     di, dj, sims, _ = _pairs(embeddings)
     steps = np.abs(di) + np.abs(dj)
@@ -164,7 +172,7 @@ def _pose_pairs(embeddings: Embeddings) -> tuple[np.ndarray, np.ndarray]:
 
 def choose_threshold(embeddings: Embeddings) -> dict[str, float]:
     """Epsilon maximising balanced accuracy of same-pose vs one-step pairs (see module doc)."""
-    same, step = _pose_pairs(embeddings)
+    same, step = pose_pairs(embeddings)
     if not len(same) or not len(step):
         return {"epsilon": float("nan"), "balanced_accuracy": float("nan")}
     candidates = np.unique(np.concatenate([same, step]))
@@ -185,7 +193,7 @@ def choose_threshold(embeddings: Embeddings) -> dict[str, float]:
 
 def threshold_quality(embeddings: Embeddings, epsilon: float) -> dict[str, float]:
     """Precision and recall of "S > epsilon means same pose" on same-pose vs one-step pairs."""
-    same, step = _pose_pairs(embeddings)
+    same, step = pose_pairs(embeddings)
     true_pos = float((same > epsilon).sum())
     false_pos = float((step > epsilon).sum())
     return {

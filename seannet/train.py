@@ -33,7 +33,7 @@ from seannet.pretrained import check_pretrained_request
 from sgdata.fileio import atomic_write_text
 from sgdata.seeds import epoch_dropout_seed, epoch_order_seed, init_seed
 
-__all__ = ["EpochResult", "train", "build_for_dataset", "device_for_run"]
+__all__ = ["EpochResult", "train", "build_for_dataset", "device_for_run", "param_groups"]
 
 LAST, BEST, HISTORY = "last.pt", "best.pt", "history.json"
 
@@ -74,7 +74,21 @@ def build_for_dataset(  # noqa: ANN201
         dropout=config.dropout,
         pretrained=pretrained,
         pretrained_sha256=pretrained_sha256,
+        visual_features=config.visual_features,
     )
+
+
+def param_groups(model: torch.nn.Module, config: TrainConfig) -> list[dict[str, Any]]:
+    """Optimiser groups: the pretrained-shape image network (``backbone``, ``head``) at
+    ``lr``, every layer SeanNet adds (object fcn, GCN, norms, fusion) at
+    ``lr * new_layers_lr_scale``; baselines are one group."""
+    image_net, added = [], []
+    for name, param in model.named_parameters():
+        (image_net if name.startswith(("backbone.", "head.", "encoder.")) else added).append(param)
+    groups = [{"params": image_net, "lr": config.lr}]
+    if added:
+        groups.append({"params": added, "lr": config.lr * config.new_layers_lr_scale})
+    return groups
 
 
 def train(
@@ -108,7 +122,7 @@ def train(
     model = build_for_dataset(
         config, data, pretrained=pretrained, pretrained_sha256=pretrained_sha256
     ).to(device)
-    optimizer = torch.optim.SGD(model.parameters(), lr=config.lr, momentum=config.momentum)
+    optimizer = torch.optim.SGD(param_groups(model, config), lr=config.lr, momentum=config.momentum)
     schedule = torch.optim.lr_scheduler.StepLR(optimizer, config.decay_every, config.lr_decay)
     history: list[dict[str, Any]] = []
     best = -1.0

@@ -14,6 +14,7 @@ from torch import Tensor
 
 from seannet.batch import NUM_RELATIONS
 from seannet.errors import DataError
+from sgdata.annotate.relations import RelationType
 
 __all__ = [
     "IMAGENET_MEAN",
@@ -125,12 +126,14 @@ def graph_tensors(
         boxes in the image's own frame (objects in row order), and (3, M, M) float32.
 
     Adjacency: channel r of ``on``, ``in``, ``proximity`` (relation type codes 0, 1, 2 of the
-    manifest's ``relation_types``; ``disjoint`` (3) is not fed) holds
-    ``A[r, slot(src), slot(dst)] = 1`` for each edge, then each row is divided by its sum, so
-    a node averages over its out-neighbours of that relation; rows without edges (absent
-    nodes included) stay zero. No self-loops are added: the authors' code row-normalised the
-    bare A, and the GCN layers keep a node's own feature through their input to the fusion,
-    not through A.
+    manifest's ``relation_types``; ``disjoint`` (3) is not fed), oriented as in the paper
+    (§IV-A: ``A(o_i, o_j) = on`` means o_j is on o_i): the stored edge ``mug -> table`` (the
+    mug rests on the table) sets ``A[on, slot(table), slot(mug)]``, so a support gathers what
+    it carries; proximity is symmetric. Every present object also gets a self-loop in every
+    channel (Kipf & Welling's A + I; the authors' code sets ``A[i, i] = 1`` for each present
+    object): without it a node's feature survives a layer only through an edge of that type,
+    and since ``on`` / ``in`` never chain three deep, those pathways output exactly zero after
+    three layers. Each row is then divided by its sum; rows of absent slots stay zero.
 
     Raises:
         DataError: a slot outside [0, M), two objects sharing a slot, or a relation naming
@@ -172,8 +175,9 @@ def graph_from_columns(
 
     Returns:
         ``(slots, class_ids, boxes, edge_index, edge_weight)``: edge_index (3, E) long holds
-        [relation, src slot, dst slot] of each distinct fed edge, edge_weight (E,) float32 its
-        row-normalised value (1 / out-degree of the source in that relation).
+        [relation, row slot, column slot] of each non-zero cell (edges oriented as in
+        :func:`graph_tensors`, and self-loops), edge_weight (E,) float32 its row-normalised
+        value (1 / degree of the row in that relation).
     """
     m = num_slots
     slot = np.asarray(slot, dtype=np.int64)
@@ -186,6 +190,7 @@ def graph_from_columns(
     fed = rtype < NUM_RELATIONS  # 'disjoint' and any later type are not GCN pathways
     edge_index = np.zeros((3, 0), dtype=np.int64)
     edge_weight = np.zeros(0, dtype=np.float32)
+    cells: list[np.ndarray] = []
     if fed.any():
         instance = np.asarray(instance, dtype=np.int64)
         order = np.argsort(instance, kind="stable")
@@ -199,8 +204,19 @@ def graph_from_columns(
             raise DataError(f"a relation names instance {missing}, not among the row's objects")
         ends_slot = slot[order][pos]
         n = int(fed.sum())
-        # distinct (relation, src, dst) cells, then 1 / out-degree per (relation, src) row
-        cell = np.unique((rtype[fed] * m + ends_slot[:n]) * m + ends_slot[n:])
+        kind = rtype[fed]
+        # on / in point from the object on top (inside) to its support (container): the
+        # paper's row is the support, so those edges are transposed
+        flip = (kind == RelationType.ON) | (kind == RelationType.IN)
+        row_slot = np.where(flip, ends_slot[n:], ends_slot[:n])
+        col_slot = np.where(flip, ends_slot[:n], ends_slot[n:])
+        cells.append((kind * m + row_slot) * m + col_slot)
+    if slot.size:  # a self-loop for every present object, in every channel
+        loops = np.arange(NUM_RELATIONS, dtype=np.int64)[:, None] * m + slot[None, :]
+        cells.append((loops * m + slot[None, :]).ravel())
+    if cells:
+        # distinct (relation, row, col) cells, then 1 / degree per (relation, row)
+        cell = np.unique(np.concatenate(cells))
         row = cell // m
         _, inverse, degree = np.unique(row, return_inverse=True, return_counts=True)
         edge_index = np.stack((row // m, row % m, cell % m))

@@ -7,6 +7,9 @@ same stream by accident and a path never changes without this file changing::
                   │                                     └─ view_seed(layout, i, j, heading)
                   └─ split_triplets_seed(split) ─ triplet_stream_seed(split, room, tier)
     training seed ─ init_seed() / epoch_order_seed(epoch) / epoch_dropout_seed(epoch)
+    navigator seed ─ navigator_init_seed() / navigator_pairs_seed(split, room)
+                   └ navigator_order_seed(epoch)
+    navigation test seed ─ episode_seed(room, case, index)
 """
 
 from __future__ import annotations
@@ -28,10 +31,16 @@ __all__ = [
     "init_seed",
     "epoch_order_seed",
     "epoch_dropout_seed",
+    "navigator_init_seed",
+    "navigator_pairs_seed",
+    "navigator_order_seed",
+    "episode_seed",
 ]
 
 _TRIPLETS = "triplets"  # the purpose key of triplet streams
 _INIT = 1 << 20  # the initial weights (epochs use 0, 1, 2, ...)
+_NAVIGATOR = "navigator"  # the purpose key of the visual navigator's streams
+_EPISODES = "episodes"  # the purpose key of the navigation test's episodes
 
 
 def derive_seed(parent: int, *keys: int) -> int:
@@ -98,3 +107,24 @@ def epoch_order_seed(training_seed: int, epoch: int) -> int:
 def epoch_dropout_seed(training_seed: int, epoch: int) -> int:
     """The seed of an epoch's dropout masks."""
     return derive_seed(training_seed, epoch, 1)
+
+
+def navigator_init_seed(training_seed: int) -> int:
+    """The seed of the visual navigator's initial weights."""
+    return derive_seed(training_seed, name_key(_NAVIGATOR), _INIT)
+
+
+def navigator_pairs_seed(training_seed: int, split: str, room_id: str) -> int:
+    """The stream of (current, goal) training pairs drawn in one room of one split."""
+    return derive_seed(training_seed, name_key(_NAVIGATOR), name_key(split), name_key(room_id))
+
+
+def navigator_order_seed(training_seed: int, epoch: int) -> int:
+    """The seed of one navigator epoch's batch order."""
+    return derive_seed(training_seed, name_key(_NAVIGATOR), epoch)
+
+
+def episode_seed(test_seed: int, room_id: str, case: str, index: int) -> int:
+    """One navigation-test episode (its layout, start and goal), by names: every localizer
+    run is tested on the same episodes."""
+    return derive_seed(test_seed, name_key(_EPISODES), name_key(room_id), name_key(case), index)

@@ -258,6 +258,11 @@ def in_group(pgid: int) -> list[int]:
     return [p for p in live_pids() if (s := _stat(p)) is not None and s[1] == pgid]
 
 
+def in_session(sid: int) -> list[int]:
+    """Live processes of session ``sid`` (a run started with ``start_new_session``)."""
+    return [p for p in live_pids() if (s := _stat(p)) is not None and s[2] == sid]
+
+
 def ancestors(pid: int) -> set[int]:
     found = set()
     while pid > 1 and (s := _stat(pid)) is not None:
@@ -299,6 +304,7 @@ def procs() -> SimpleNamespace:
     """The /proc probes above, for tests that kill real runs."""
     return SimpleNamespace(
         in_group=in_group,
+        in_session=in_session,
         strays_since=strays_since,
         start_ticks=start_ticks,
         wait_until_gone=wait_until_gone,

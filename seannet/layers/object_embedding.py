@@ -10,7 +10,9 @@ from torch import Tensor, nn
 from seannet.errors import ModelError
 from seannet.layers.box_encoding import BoxEncoding
 
-__all__ = ["ObjectEmbedding"]
+__all__ = ["OBJECT_INPUTS", "ObjectEmbedding"]
+
+OBJECT_INPUTS = ("visual", "box", "word")  # x_v, x_b, x_w
 
 
 class ObjectEmbedding(nn.Module):
@@ -25,13 +27,18 @@ class ObjectEmbedding(nn.Module):
     with :math:`x_v` the RoI feature after the ResNet head (computed by the caller),
     :math:`x_b` the :class:`BoxEncoding` of the box and :math:`x_w` the fixed word vector of
     the class (a buffer: word vectors are not trained, as in the paper). For ResNet-50 the
-    fcn is 2048 + 256 + 300 = 2604 → 1024 → 512.
+    fcn is 2048 + 256 + 300 = 2604 → 1024 → 512. Word vectors are scaled to unit length: raw
+    GloVe rows have norms of 4-8 and would outweigh the other inputs at initialisation.
+
+    ``inputs`` names the parts fed to the fcn (default all three); leaving one out is an
+    ablation (the fcn's input shrinks accordingly).
 
     Args:
         word_vectors: :math:`(C, D_w)` float tensor, row c the word vector of class id c.
         visual_dim: width of :math:`x_v` (2048 for ResNet-50, 512 for ResNet-18/34).
         box_dim_per_coord: PE channels per box coordinate (default 64 → :math:`x_b` 256-d).
         hidden_dims: fcn widths after the input (default (1024, 512)).
+        inputs: which of ``"visual"``, ``"box"``, ``"word"`` to feed (default all).
 
     Shapes:
         - **visual**: :math:`(K, D_v)`
@@ -49,8 +56,14 @@ class ObjectEmbedding(nn.Module):
         *,
         box_dim_per_coord: int = 64,
         hidden_dims: Sequence[int] = (1024, 512),
+        inputs: Sequence[str] = OBJECT_INPUTS,
     ) -> None:
         super().__init__()
+        inputs = tuple(inputs)
+        if not inputs or any(i not in OBJECT_INPUTS for i in inputs):
+            raise ModelError(
+                f"object inputs {inputs}; expected a non-empty subset of {OBJECT_INPUTS}"
+            )
         if word_vectors.dim() != 2 or word_vectors.shape[0] == 0:
             raise ModelError(
                 f"word_vectors: shape {tuple(word_vectors.shape)}; expected (classes, dim)"
@@ -60,10 +73,18 @@ class ObjectEmbedding(nn.Module):
         hidden_dims = tuple(int(h) for h in hidden_dims)
         if not hidden_dims or min(hidden_dims) <= 0:
             raise ModelError(f"hidden_dims={hidden_dims}; expected positive widths")
-        self.register_buffer("word_vectors", word_vectors.detach().to(torch.float32).clone())
+        vectors = word_vectors.detach().to(torch.float32)
+        unit = vectors / vectors.norm(dim=1, keepdim=True).clamp_min(1e-12)
+        self.register_buffer("word_vectors", unit.clone())
         self.box_encoding = BoxEncoding(box_dim_per_coord)
         self.visual_dim = visual_dim
-        self.in_dim = visual_dim + self.box_encoding.out_dim + word_vectors.shape[1]
+        self.inputs = inputs
+        widths = {
+            "visual": visual_dim,
+            "box": self.box_encoding.out_dim,
+            "word": word_vectors.shape[1],
+        }
+        self.in_dim = sum(widths[i] for i in inputs)
         layers: list[nn.Module] = []
         width = self.in_dim
         for h in hidden_dims:
@@ -82,6 +103,11 @@ class ObjectEmbedding(nn.Module):
                 m.reset_parameters()
 
     def forward(self, visual: Tensor, boxes: Tensor, class_ids: Tensor) -> Tensor:
-        x_b = self.box_encoding(boxes)
-        x_w = self.word_vectors[class_ids]
-        return self.fcn(torch.cat((visual, x_b, x_w), dim=1))
+        parts = []
+        if "visual" in self.inputs:
+            parts.append(visual)
+        if "box" in self.inputs:
+            parts.append(self.box_encoding(boxes))
+        if "word" in self.inputs:
+            parts.append(self.word_vectors[class_ids])
+        return self.fcn(torch.cat(parts, dim=1))

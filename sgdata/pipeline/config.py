@@ -40,7 +40,7 @@ __all__ = [
     "load_config",
 ]
 
-PRESETS = ("tiny", "small", "paper")
+PRESETS = ("tiny", "small", "medium", "paper")
 
 
 @dataclass(frozen=True)

@@ -6,8 +6,8 @@ the driver, but the raylet's agents noticed only ~60 s later (measured here). Th
 small process in a session of its own, holding the read end of a pipe whose write end only the
 run holds. Twice a second it notes the run's descendants started since the reaper (pid and
 start time, so a reused pid is never killed); when the pipe reaches end of file (the run
-exited or was killed), it kills what it noted and what those started, then exits. Linux only (it reads ``/proc``); elsewhere
-it is not started.
+exited or was killed), it kills what it noted and what those started, then exits. Linux only
+(it reads ``/proc``); elsewhere it is not started.
 """
 
 from __future__ import annotations

@@ -12,7 +12,7 @@ from sgdata.errors import ConfigError
 from sgdata.render.camera import CameraConfig
 from sgdata.render.renderer import Renderer
 from sgdata.usd.geometry import read_geometry
-from sgdata.usd.scene_dirs import layout_file, load_layout
+from sgdata.usd.scene_dirs import layout_path, load_layout
 from sgdata.world.catalog import Catalog, load_catalog
 from sgdata.world.poses import HEADINGS_DEG, pose_grid
 
@@ -66,5 +66,5 @@ def render_snapshot(
             min_visible_pixels=min_visible_pixels,
             rules=RelationRules(),
         )
-        annotator.set_layout(room, read_geometry(layout_file(room_dir, layout)), layout)
+        annotator.set_layout(room, read_geometry(layout_path(room_dir, layout)), layout)
         return annotator.view(ViewPose(x, y, theta, i, j, heading))

@@ -94,6 +94,8 @@ class Renderer:
         RenderError: EGL cannot start (names the packages to install).
     """
 
+    _open = 0  # renderers of this process with a live GL context (see close)
+
     def __init__(
         self,
         camera: CameraConfig | None = None,
@@ -117,6 +119,7 @@ class Renderer:
             self._pr = pyrender
             self._gl = pyrender.OffscreenRenderer(self.camera.width, self.camera.height)
             self._gl._renderer._sorted_mesh_nodes = self._draw_order
+            Renderer._open += 1
         except Exception as exc:  # any failure here is an environment problem, not a bug
             why = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
             raise RenderError(_EGL_HINT.format(why=why)) from None
@@ -304,12 +307,26 @@ class Renderer:
     def close(self) -> None:
         """Free the GL context (also done when the renderer is garbage-collected).
 
-        pyrender terminates the EGL display on close, which breaks any other renderer of the
-        same process: keep one renderer per process (per worker) and close it last.
+        pyrender's own close terminates the EGL display, which every renderer of the process
+        shares (``eglTerminate`` is not reference-counted): closing one renderer broke the
+        others. Here the display is terminated only by the last open renderer.
         """
-        if self._gl is not None:
+        if self._gl is None:
+            return
+        Renderer._open -= 1
+        platform = self._gl._platform
+        if Renderer._open > 0 and getattr(platform, "_egl_context", None) is not None:
+            from OpenGL.EGL import eglDestroyContext
+
+            platform.make_current()
+            self._gl._renderer.delete()
+            eglDestroyContext(platform._egl_display, platform._egl_context)
+            platform._egl_context = None  # pyrender then skips the context, keeps the display
+            platform._egl_display = None
+            self._gl._renderer = self._gl._platform = None
+        else:
             self._gl.delete()
-            self._gl = None
+        self._gl = None
 
     def __enter__(self) -> Renderer:
         return self

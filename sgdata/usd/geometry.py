@@ -1,7 +1,7 @@
 """Reading a composed stage's meshes for rendering, from pxr alone (no catalog needed).
 
-Any stage whose object prims carry ``sgdata:instance`` renders, whatever tool wrote it: a prim
-with that attribute is an object, every mesh beneath it is part of that object (expressed in
+Any stage whose object prims carry ``sgdata:class`` or ``sgdata:instance`` renders, whatever
+tool wrote it: such a prim is an object, every mesh beneath it is part of that object (expressed in
 the object's local frame), and every other mesh is structure (in world space). Faces with more
 than three corners are fanned into triangles; ``primvars:displayColor`` gives the face colours
 (constant, uniform, vertex and faceVarying interpolation; grey when absent).
@@ -14,12 +14,14 @@ from pathlib import Path
 import numpy as np
 from pxr import Usd, UsdGeom
 
-from sgdata.errors import UsdError
+from sgdata.usd.gprims import tessellate_gprim
 from sgdata.usd.meshes import MeshData, ObjectGeometry, SceneGeometry, merge_meshes
+from sgdata.usd.object_prims import drawn, instance_ids, is_object
 from sgdata.usd.room_io import open_stage
+from sgdata.usd.stage_frame import stage_frame
 from sgdata.world.scene import transform_points
 
-__all__ = ["DEFAULT_COLOR", "read_geometry"]
+__all__ = ["DEFAULT_COLOR", "read_geometry", "stage_geometry"]
 
 DEFAULT_COLOR = (0.6, 0.6, 0.6)  # face colour of meshes without a displayColor
 
@@ -27,68 +29,77 @@ DEFAULT_COLOR = (0.6, 0.6, 0.6)  # face colour of meshes without a displayColor
 def read_geometry(path: Path) -> SceneGeometry:
     """The triangle meshes of the composed stage at ``path`` (a room, a layout, any USD file).
 
-    Invisible prims and guide/proxy purposes are skipped; instance proxies are followed.
+    Invisible prims and guide/proxy purposes are skipped; instance proxies are followed. Meshes
+    and the gprims ``Cube``, ``Cylinder``, ``Cone``, ``Capsule`` and ``Sphere`` (tessellated)
+    are read, under any nesting of Xforms. Coordinates come back in the room frame (Z up,
+    metres, see :func:`sgdata.usd.stage_frame.stage_frame`) whatever the stage's up axis,
+    units and origin.
 
     Raises:
         UsdError: the file is missing, unreadable or does not compose, or an object prim has
             a non-integer or duplicate ``sgdata:instance``.
     """
     path = Path(path)
-    stage = open_stage(path)
+    return stage_geometry(open_stage(path), path)
+
+
+def stage_geometry(stage: Usd.Stage, path: Path) -> SceneGeometry:
+    """:func:`read_geometry` of an open stage (``path`` names it in messages)."""
+    frame = stage_frame(stage)
     cache = UsdGeom.XformCache(Usd.TimeCode.Default())
     owners: dict[str, Usd.Prim] = {}  # object prim path -> prim, in traversal order
     parts: dict[str, list[MeshData]] = {}
     structure = []
     prims = iter(Usd.PrimRange.Stage(stage, Usd.TraverseInstanceProxies()))
     for prim in prims:
-        if not _drawn(prim):
+        if not drawn(prim):
             prims.PruneChildren()  # type: ignore[attr-defined]
             continue
-        if prim.HasAttribute("sgdata:instance"):
+        if is_object(prim):
             owners[str(prim.GetPath())] = prim
             parts.setdefault(str(prim.GetPath()), [])
-        if not prim.IsA(UsdGeom.Mesh):
+        found = _prim_triangles(prim)
+        if found is None:
             continue
-        vertices, faces, colors = _triangles(UsdGeom.Mesh(prim))
-        world = _world(cache, prim)
+        vertices, faces, colors = found
+        world = _world(cache, prim, frame)
         owner = _owner(prim, owners)
         if owner is None:
             structure.append(
                 MeshData(transform_points(world, vertices), faces, colors, str(prim.GetPath()))
             )
         else:
-            to_owner = np.linalg.inv(_world(cache, owner)) @ world
+            to_owner = np.linalg.inv(_world(cache, owner, frame)) @ world
             parts[str(owner.GetPath())].append(
                 MeshData(transform_points(to_owner, vertices), faces, colors)
             )
+    ids = instance_ids(path, list(owners.values()))
     objects = []
-    seen: dict[int, str] = {}
     for key, prim in owners.items():
-        instance = prim.GetAttribute("sgdata:instance").Get()
-        if not isinstance(instance, int) or isinstance(instance, bool):
-            raise UsdError(f"{path}: {key} sgdata:instance is {instance!r}; expected an integer")
-        if instance in seen:
-            raise UsdError(f"{path}: {key} and {seen[instance]} share sgdata:instance {instance}")
-        seen[instance] = key
         cls = prim.GetAttribute("sgdata:class").Get() if prim.HasAttribute("sgdata:class") else None
         objects.append(
             ObjectGeometry(
-                instance=instance,
+                instance=ids[key],
                 class_name=str(cls) if cls else prim.GetName(),
                 mesh=merge_meshes(parts[key], key),
-                matrix=_world(cache, prim),
+                matrix=_world(cache, prim, frame),
             )
         )
     return SceneGeometry(structure=tuple(structure), objects=tuple(objects))
 
 
-def _drawn(prim: Usd.Prim) -> bool:
-    if not prim.IsA(UsdGeom.Imageable):
-        return True
-    imageable = UsdGeom.Imageable(prim)
-    if imageable.GetVisibilityAttr().Get() == UsdGeom.Tokens.invisible:
-        return False
-    return imageable.GetPurposeAttr().Get() not in (UsdGeom.Tokens.guide, UsdGeom.Tokens.proxy)
+def _prim_triangles(prim: Usd.Prim) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """The triangles of a mesh or a tessellated gprim in its own frame; ``None`` for others."""
+    if prim.IsA(UsdGeom.Mesh):
+        return _triangles(UsdGeom.Mesh(prim))
+    if prim.IsA(UsdGeom.Gprim):
+        found = tessellate_gprim(prim)
+        if found is None:
+            return None
+        vertices, faces = found
+        colors = _face_colors(UsdGeom.Gprim(prim), np.full(len(faces), 3))
+        return vertices, faces, colors
+    return None
 
 
 def _owner(prim: Usd.Prim, owners: dict[str, Usd.Prim]) -> Usd.Prim | None:
@@ -99,9 +110,10 @@ def _owner(prim: Usd.Prim, owners: dict[str, Usd.Prim]) -> Usd.Prim | None:
     return None
 
 
-def _world(cache: UsdGeom.XformCache, prim: Usd.Prim) -> np.ndarray:
+def _world(cache: UsdGeom.XformCache, prim: Usd.Prim, frame: np.ndarray | None) -> np.ndarray:
     # USD matrices act on row vectors (p' = p M): transpose for the column convention
-    return np.array(cache.GetLocalToWorldTransform(prim), dtype=np.float64).T
+    m = np.array(cache.GetLocalToWorldTransform(prim), dtype=np.float64).T
+    return m if frame is None else frame @ m
 
 
 def _triangles(mesh: UsdGeom.Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -130,7 +142,7 @@ def _triangles(mesh: UsdGeom.Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return vertices, faces, colors
 
 
-def _display_color(mesh: UsdGeom.Mesh) -> tuple[np.ndarray, str] | None:
+def _display_color(mesh: UsdGeom.Gprim) -> tuple[np.ndarray, str] | None:
     primvar = UsdGeom.PrimvarsAPI(mesh.GetPrim()).GetPrimvar("displayColor")
     if not primvar or not primvar.HasValue():
         return None
@@ -140,7 +152,7 @@ def _display_color(mesh: UsdGeom.Mesh) -> tuple[np.ndarray, str] | None:
     return np.array(values, dtype=np.float32).reshape(-1, 3), primvar.GetInterpolation()
 
 
-def _face_colors(mesh: UsdGeom.Mesh, counts: np.ndarray) -> np.ndarray:
+def _face_colors(mesh: UsdGeom.Gprim, counts: np.ndarray) -> np.ndarray:
     found = _display_color(mesh)
     n = len(counts)
     if found is not None:

@@ -24,6 +24,7 @@ from pxr import Gf, Sdf, UsdGeom, Vt
 
 from sgdata.errors import SceneError, UsdError
 from sgdata.scene_files import ROOM_FILE
+from sgdata.usd.own_layouts import OwnFrame, override_own
 from sgdata.usd.room_io import ROOT, object_path, open_layer, write_text_atomic
 from sgdata.world.scene import Room, SceneObject
 
@@ -35,7 +36,14 @@ _KEY_LAYOUT, _KEY_SEED, _KEY_MOVES = "sgdata:layout", "sgdata:seed", "sgdata:mov
 
 
 def write_layout(
-    base: Room, layout: Room, path: Path, *, index: int, seed: int, moves: list[dict]
+    base: Room,
+    layout: Room,
+    path: Path,
+    *,
+    index: int,
+    seed: int,
+    moves: list[dict],
+    own: OwnFrame | None = None,
 ) -> None:
     """Write ``layout`` as a layer over ``base``, atomically and byte-reproducibly.
 
@@ -46,6 +54,8 @@ def write_layout(
         index: the layout index k, stored as provenance.
         seed: the seed the layout was sampled from, stored as provenance.
         moves: one record per object move (JSON-able values), stored as provenance.
+        own: for a room authored elsewhere (:func:`sgdata.usd.own_layouts.own_frame`): its
+            prim paths and frame; moves are then written as each prim's local matrix.
 
     Raises:
         SceneError: ``layout`` does not hold the same objects as ``base``, or the moves are
@@ -64,9 +74,9 @@ def write_layout(
         raise SceneError(f"layout {index} seed {seed} does not fit USD's int64; use one < 2**63")
     layer = Sdf.Layer.CreateAnonymous(".usda")
     layer.subLayerPaths.append(f"./{ROOM_FILE}")
-    layer.defaultPrim = ROOT.name
-    layer.pseudoRoot.SetInfo(UsdGeom.Tokens.upAxis, UsdGeom.Tokens.z)
-    layer.pseudoRoot.SetInfo(UsdGeom.Tokens.metersPerUnit, 1.0)
+    layer.defaultPrim = own.default_prim if own else ROOT.name
+    layer.pseudoRoot.SetInfo(UsdGeom.Tokens.upAxis, own.up_axis if own else UsdGeom.Tokens.z)
+    layer.pseudoRoot.SetInfo(UsdGeom.Tokens.metersPerUnit, own.meters_per_unit if own else 1.0)
     try:
         moves_json = json.dumps(moves, sort_keys=True, allow_nan=False, default=_plain)
     except (TypeError, ValueError) as exc:
@@ -85,12 +95,17 @@ def write_layout(
                 f"layout {index}: instance {old.instance} is a {new.class_name} in the layout "
                 f"but a {old.class_name} in room {base.room_id}"
             )
-        _override(layer, old, new, before)
+        _override(layer, old, new, before, after, own)
     write_text_atomic(path, layer.ExportToString())
 
 
 def _override(
-    layer: Sdf.Layer, old: SceneObject, new: SceneObject, objects: dict[int, SceneObject]
+    layer: Sdf.Layer,
+    old: SceneObject,
+    new: SceneObject,
+    objects: dict[int, SceneObject],
+    after: dict[int, SceneObject],
+    own: OwnFrame | None,
 ) -> None:
     a, b = old.placement, new.placement
     moved = any(
@@ -100,8 +115,11 @@ def _override(
     resupported = old.support != new.support
     if not (moved or resupported):
         return
-    spec = Sdf.CreatePrimInLayer(layer, object_path(old))
-    if moved:
+    where = Sdf.Path(own.paths[old.instance]) if own else object_path(old)
+    spec = Sdf.CreatePrimInLayer(layer, where)
+    if moved and own is not None:
+        override_own(layer, own, objects, after, old.instance)
+    elif moved:
         translate = Sdf.AttributeSpec(
             spec, "xformOp:translate", Sdf.ValueTypeNames.Double3, Sdf.VariabilityVarying, False
         )
@@ -119,7 +137,10 @@ def _override(
                     f"layout: object {new.prim_name} rests on instance {new.support}, "
                     f"not in the room"
                 )
-            rel.targetPathList.explicitItems = [object_path(objects[new.support])]
+            target = objects[new.support]
+            rel.targetPathList.explicitItems = [
+                Sdf.Path(own.paths[target.instance]) if own else object_path(target)
+            ]
 
 
 def read_layout_provenance(path: Path) -> dict[str, Any]:

@@ -47,7 +47,8 @@ class SceneGeometry:
 def merge_meshes(meshes: Sequence[MeshData], name: str = "") -> MeshData:
     """Meshes concatenated into one (face indices offset, colours kept per face)."""
     if not meshes:
-        return MeshData(np.zeros((0, 3)), np.zeros((0, 3), np.int32), np.zeros((0, 3), np.float32))
+        empty = np.zeros((0, 3))
+        return MeshData(empty, np.zeros((0, 3), np.int32), np.zeros((0, 3), np.float32), name)
     offsets = np.cumsum([0] + [len(m.vertices) for m in meshes[:-1]])
     return MeshData(
         np.concatenate([m.vertices for m in meshes]),

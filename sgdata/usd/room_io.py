@@ -358,15 +358,20 @@ def open_stage(path: Path, *, strict: bool = True) -> Usd.Stage:
 def read_room(path: Path) -> Room:
     """Read a room back from ``room.usda``, or the composed room of a ``layout_<k>.usda``.
 
+    A stage not written by :func:`write_room` (no ``sgdata:roomSize``, or tagged by
+    ``sgdata tag``) is measured from its geometry (:mod:`sgdata.usd.own_rooms`).
+
     Raises:
         UsdError: the file is missing, unreadable, does not compose, or lacks a ``sgdata:*``
             attribute this module writes (the message names the prim and the attribute).
     """
     path = Path(path)
     stage = open_stage(path)
+    from sgdata.usd.own_rooms import is_measured, measure_stage  # late: it reads geometry
+
+    if is_measured(stage):  # a room authored elsewhere, tagged or not
+        return measure_stage(stage, path).room
     root = stage.GetPrimAtPath(ROOT)
-    if not root.IsValid():
-        raise UsdError(f"{path}: no {ROOT} prim; not an sgdata room")
     size = _get(path, root, "sgdata:roomSize")
     door = Opening(
         wall=str(_get(path, root, "sgdata:door:wall")),

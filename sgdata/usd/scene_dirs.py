@@ -9,6 +9,7 @@ from sgdata.fileio import prepare_output_dir
 from sgdata.scene_files import LAYOUT_FILE, ROOM_FILE, layout_file, room_file
 from sgdata.seeds import layouts_seed
 from sgdata.usd.layout_layers import write_layout
+from sgdata.usd.own_layouts import own_frame
 from sgdata.usd.room_io import catalog_geometry, read_room, write_room
 from sgdata.world.catalog import Catalog, load_catalog
 from sgdata.world.dynamics import DynamicsConfig, Layout, sample_layouts
@@ -23,6 +24,7 @@ __all__ = [
     "load_base",
     "load_layout",
     "layout_indices",
+    "layout_path",
 ]
 
 
@@ -89,6 +91,7 @@ def write_layouts(
     layouts = sample_layouts(
         base, count, layouts_seed(base.seed, seed), catalog, config, poses=poses
     )
+    own = own_frame(room_file(room_dir))  # None for rooms written by 'sgdata rooms'
     for layout in layouts:
         write_layout(
             base,
@@ -97,6 +100,7 @@ def write_layouts(
             index=layout.index,
             seed=layout.seed,
             moves=[m.as_dict() for m in layout.moves],
+            own=own,
         )
     return layouts
 
@@ -111,6 +115,18 @@ def layout_indices(room_dir: Path) -> list[int]:
     return sorted(found)
 
 
+def layout_path(room_dir: Path, index: int) -> Path:
+    """The file of layout ``index``: ``layout_<k>.usda``; for 0 without one, ``room.usda``.
+
+    Layout 0 is the base arrangement, so a room tagged by ``sgdata tag`` renders before any
+    ``sgdata layouts`` run.
+    """
+    path = layout_file(room_dir, index)
+    if index == 0 and not path.is_file():
+        return room_file(room_dir)
+    return path
+
+
 def load_layout(room_dir: Path, index: int, catalog: Catalog | None = None) -> Room:
     """The composed room of layout ``index``, checked to be physically valid.
 
@@ -120,7 +136,7 @@ def load_layout(room_dir: Path, index: int, catalog: Catalog | None = None) -> R
             object inside a wall).
     """
     load_base(room_dir)
-    path = layout_file(room_dir, index)
+    path = layout_path(room_dir, index)
     if not path.is_file():
         have = layout_indices(room_dir)
         raise ConfigError(

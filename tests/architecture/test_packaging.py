@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import shutil
 import subprocess
 import sys
 import zipfile
@@ -33,6 +34,12 @@ def _expected() -> set[str]:
 
 
 def test_wheel_holds_every_module_and_data_file(tmp_path: Path) -> None:
+    # build from a clean copy: a stale build/ of the checkout would leak deleted modules in
+    source = tmp_path / "src"
+    skip = shutil.ignore_patterns(
+        ".git", ".venv", "build", "dist", "*.egg-info", "out", "__pycache__"
+    )
+    shutil.copytree(ROOT, source, ignore=skip)
     subprocess.run(
         [
             sys.executable,
@@ -44,7 +51,7 @@ def test_wheel_holds_every_module_and_data_file(tmp_path: Path) -> None:
             "-q",
             "-w",
             str(tmp_path),
-            str(ROOT),
+            str(source),
         ],
         check=True,
         capture_output=True,

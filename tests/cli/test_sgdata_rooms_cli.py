@@ -79,7 +79,7 @@ def test_malformed_catalog(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("args", "needle"),
     [
-        (("generate", "huge", "{tmp}/d"), "expected one of tiny, small, paper"),
+        (("generate", "huge", "{tmp}/d"), "expected one of tiny, small, medium, paper"),
         (("generate", "{tmp}/bad.toml", "{tmp}/d"), "unknown key 'roomz'"),
         (("generate", "tiny", "{tmp}/a_file"), "is a file"),
     ],

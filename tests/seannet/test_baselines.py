@@ -28,6 +28,8 @@ CASES = [
     ("resnext50", 64, 2048),
     ("vgg16", 32, 4096),
     ("googlenet", 64, 1024),
+    # the optional `lite` extra; skipped without it (see tests/seannet/test_backbones_lite.py)
+    ("efficientnet_lite0", 64, 1280),
 ]
 
 
@@ -37,6 +39,8 @@ def test_every_baseline_is_tested() -> None:
 
 @pytest.mark.parametrize(("name", "size", "native"), CASES)
 def test_baseline_embeds_images_to_2048(name: str, size: int, native: int) -> None:
+    if name == "efficientnet_lite0":
+        pytest.importorskip("efficientnet_lite_pytorch", reason="the optional `lite` extra")
     torch.manual_seed(0)
     model = build_model(name).eval()
     assert isinstance(model, ImageEncoder)

@@ -32,12 +32,17 @@ SIZE = 64  # the tests' resize target (the mini dataset renders 96 x 96)
 
 
 def reference_graph(objects: list[dict], relations: list[dict], num_slots: int) -> np.ndarray:
-    """The plain per-edge version of graph_tensors' adjacency."""
+    """The plain per-edge version of graph_tensors' adjacency: on / in transposed (the
+    support's row holds what rests on it, paper §IV-A), A + I for present objects."""
     slot_of = {o["instance"]: o["slot"] for o in objects}
     a = np.zeros((3, num_slots, num_slots), dtype=np.float64)
     for e in relations:
-        if e["type"] < 3:
+        if e["type"] in (0, 1):
+            a[e["type"], slot_of[e["dst"]], slot_of[e["src"]]] = 1.0
+        elif e["type"] == 2:
             a[e["type"], slot_of[e["src"]], slot_of[e["dst"]]] = 1.0
+    for o in objects:
+        a[:, o["slot"], o["slot"]] = 1.0
     for r in range(3):
         for i in range(num_slots):
             total = sum(a[r, i])
@@ -89,11 +94,15 @@ def test_graph_tensors_drop_disjoint_and_normalise_rows() -> None:
     ]
     slots, class_ids, boxes, adj = graph_tensors(objects, relations, num_slots=16)
     assert slots.tolist() == [4, 9, 10] and class_ids.tolist() == [1, 2, 2]
-    assert adj[0, 9, 4] == 1.0 and adj[0].sum() == 1.0
-    assert adj[1].sum() == 0.0
-    assert adj[2, 9, 10] == adj[2, 9, 4] == 0.5 and adj[2, 10, 9] == 1.0
-    assert adj[2, 4].sum() == 0.0  # node 4 has no out-edges of that type; no self-loop
-    assert torch.diagonal(adj, dim1=1, dim2=2).sum() == 0.0
+    # on: 3 rests on 7, so the support's row (slot 4) holds slot 9, beside its self-loop
+    assert adj[0, 4, 9] == adj[0, 4, 4] == 0.5 and adj[0, 9, 4] == 0.0 and adj[0, 9, 9] == 1.0
+    assert torch.equal(adj[1], torch.diag(adj[1].diagonal()))  # in: self-loops only
+    assert adj[1].diagonal()[[4, 9, 10]].tolist() == [1.0, 1.0, 1.0]
+    assert adj[2, 9, 10] == adj[2, 9, 4] == adj[2, 9, 9] == pytest.approx(1 / 3)
+    assert adj[2, 10, 9] == adj[2, 10, 10] == 0.5
+    assert adj[2, 4, 4] == 1.0  # node 4 has no proximity edge of its own: its self-loop
+    assert torch.allclose(adj.sum(dim=2)[:, [4, 9, 10]], torch.ones(3, 3))  # rows sum to 1
+    assert adj.sum() == 9.0  # absent slots stay zero
     empty = graph_tensors([], [], num_slots=16)
     assert empty[0].shape == (0,) and empty[2].shape == (0, 4) and empty[3].sum() == 0
 

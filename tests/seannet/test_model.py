@@ -177,4 +177,7 @@ def test_word_vectors_are_rows_in_class_id_order() -> None:
     net = SeanNet(table.matrix(names), depth=18, num_slots=8, graph_hidden_dim=16)
     assert net.num_classes == len(names)
     mug = names.index("Mug")
-    torch.testing.assert_close(net.objects.word_vectors[mug], torch.from_numpy(table.vector("Mug")))
+    raw = torch.from_numpy(table.vector("Mug"))
+    # stored at unit length (raw GloVe norms of 4-8 would outweigh x_v and x_b)
+    torch.testing.assert_close(net.objects.word_vectors[mug], raw / raw.norm())
+    assert torch.allclose(net.objects.word_vectors.norm(dim=1), torch.ones(len(names)))

@@ -130,3 +130,21 @@ def test_camera_projection_conventions() -> None:
     # points above the eye are in the upper half (smaller v)
     uvz = cam.project(np.array([[3.0, 0.0, 2.0]]), 0.0, 0.0, 0.0)
     assert uvz[0, 1] < 112
+
+
+def test_closing_one_renderer_leaves_the_others_working(tiny_room) -> None:  # noqa: ANN001
+    """pyrender's close terminates the process's shared EGL display; ours does so only when
+    the last renderer closes."""
+    from sgdata.render.renderer import Renderer
+
+    first, second = Renderer(), Renderer()
+    first.load(tiny_room.geometry)
+    second.load(tiny_room.geometry)
+    before = first.render(1.0, 1.0, 0.0).rgb.copy()
+    second.close()
+    assert np.array_equal(first.render(1.0, 1.0, 0.0).rgb, before)
+    first.close()
+    third = Renderer()
+    third.load(tiny_room.geometry)
+    assert np.array_equal(third.render(1.0, 1.0, 0.0).rgb, before)
+    third.close()
