@@ -29,14 +29,24 @@ def train(
     data: Data,
     out: Annotated[Path, typer.Option("--out", help="Run directory for checkpoints.")],
     model: Annotated[
-        str, typer.Option(help="seannet | resnet18 | resnet50 | resnext50 | vgg16 | googlenet")
+        str,
+        typer.Option(
+            help="seannet (or an ablation: seannet-graph, ...) | resnet18 | resnet50 | resnext50 "
+            "| vgg16 | googlenet | efficientnet_lite0"
+        ),
     ] = "seannet",
     preset: Annotated[str, typer.Option(help="cpu | paper")] = "cpu",
+    backbone: Annotated[
+        str | None, typer.Option(help="SeanNet's image network: resnet | efficientnet_lite0.")
+    ] = None,
     epochs: Annotated[int, typer.Option(help="Override the preset's epochs (0 keeps it).")] = 0,
     resume: Annotated[bool, typer.Option(help="Continue the run in --out.")] = False,
     pretrained: Annotated[
         Path | None,
-        typer.Option(help="Local ImageNet weights (torchvision state_dict), sha256-checked."),
+        typer.Option(
+            help="ImageNet weights: a local torchvision state_dict (sha256-checked), or "
+            "imagenet-lite0 for EfficientNet-Lite0's from the `lite` extra."
+        ),
     ] = None,
     pretrained_sha256: Annotated[
         str | None, typer.Option(help="Expected SHA-256 of --pretrained (default: known hashes).")
@@ -50,6 +60,8 @@ def train(
     from seannet.train import train as run_training
 
     config = load_preset(preset).replace(model=model, seed=seed)
+    if backbone:
+        config = config.replace(backbone=backbone)
     if epochs:
         config = config.replace(epochs=epochs)
     with Progress(console=console, transient=True) as bar:

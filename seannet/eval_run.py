@@ -59,7 +59,7 @@ def evaluate_run(run: Path, data: Path, *, split: str = "test", out: Path | None
     model = build_for_dataset(config, data).to(device)
     model.load_state_dict(state["model"])
     evaluated = embed_split(model, config, data, split, device)
-    transform = ImageTransform(size=config.image_size)
+    transform = ImageTransform.for_model(config.image_size, config.image_family)
     triplets = TripletDataset(data, split, transform=transform)
     metrics = triplet_metrics(evaluated, triplets)
     s_ap, s_an = triplet_similarities(evaluated, triplets)

@@ -65,7 +65,9 @@ def embed_split(
     model: torch.nn.Module, config: TrainConfig, data: Path, split: str, device: torch.device
 ) -> Embeddings:
     """Embed every observation of ``split`` once (eval mode)."""
-    dataset = ObservationDataset(data, split, transform=ImageTransform(size=config.image_size))
+    dataset = ObservationDataset(
+        data, split, transform=ImageTransform.for_model(config.image_size, config.image_family)
+    )
     loader = DataLoader(
         dataset,
         batch_size=config.batch_size,

@@ -233,7 +233,7 @@ def build_image_cache(
     s = int(transform.size)
     try:
         files = ds.observation_files(split)
-        counts = [_call_rows(p) for p in files]
+        counts = [_rows(p) for p in files]
         directory.mkdir(parents=True, exist_ok=True)
         fd, tmp = tempfile.mkstemp(dir=directory, prefix=f".{split}.npy.", suffix=".tmp")
         os.close(fd)
@@ -260,6 +260,8 @@ def build_image_cache(
             obs_ids += ids
         out.flush()
         del out
+        # no moment where an old JSON vouches for the new array
+        (directory / f"{split}.json").unlink(missing_ok=True)
         os.replace(tmp, directory / f"{split}.npy")
     except OSError as exc:
         raise DataError(f"image cache {directory}: cannot write ({exc.strerror or exc})") from None
@@ -280,5 +282,5 @@ def _read(path: Path, columns: tuple[str, ...]) -> Any:
         raise DataError(" ".join(str(exc).split())) from None
 
 
-def _call_rows(path: Path) -> int:
+def _rows(path: Path) -> int:
     return _read(path, ("obs_id",)).num_rows

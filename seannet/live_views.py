@@ -19,6 +19,7 @@ import torch
 
 from seannet.data import ImageTransform, ViewTensors, open_dataset
 from seannet.errors import DataError
+from seannet.retrieval import MOVE_TOLERANCE
 from seannet.view_inputs import graph_from_columns
 from sgdata.dataset import Dataset, decode_image
 from sgdata.dataset.paths import scene_dir
@@ -28,15 +29,12 @@ from sgdata.scene_files import layout_file
 from sgdata.seeds import rng_for, view_seed
 
 __all__ = [
-    "MOVE_TOLERANCE",
     "LiveRooms",
     "RenderSettings",
     "layout_boxes",
     "moved_instances",
     "view_tensors",
 ]
-
-MOVE_TOLERANCE = 1e-3  # metres: a 3D box corner further than this from its old place moved
 
 
 @dataclass(frozen=True)

@@ -27,17 +27,27 @@ from seannet.eval_run import MODEL_KEYS
 from seannet.live_views import layout_boxes, moved_instances
 from seannet.localizer import Localizer, load_localizer
 from seannet.maps import TopoMap, check_map, load_map, map_dirs
+from seannet.retrieval import MOVED_BINS, recall_at_k
 from sgdata.fileio import atomic_write_text
 
-__all__ = ["MOVED_BINS", "moved_bin", "match", "localize_queries", "retrieval", "run_localize"]
+__all__ = ["BIN_NAMES", "moved_bin", "match", "localize_queries", "retrieval", "run_localize"]
 
-MOVED_BINS = ("0", "1-2", "3-5", "6+")
 TOP = 5
 
 
+def _bin_name(lo: int, hi: int | None) -> str:
+    return f"{lo}" if lo == hi else (f"{lo}-{hi}" if hi is not None else f"{lo}+")
+
+
+BIN_NAMES = tuple(_bin_name(lo, hi) for lo, hi in MOVED_BINS)  # 0, 1-2, 3-5, 6+
+
+
 def moved_bin(count: int) -> str:
-    """The bin of a number of moved objects in view."""
-    return "0" if count == 0 else "1-2" if count <= 2 else "3-5" if count <= 5 else "6+"
+    """The bin (of :data:`seannet.retrieval.MOVED_BINS`) of a number of moved objects."""
+    for (lo, hi), name in zip(MOVED_BINS, BIN_NAMES, strict=True):
+        if count >= lo and (hi is None or count <= hi):
+            return name
+    raise ValueError(f"moved object count {count} < 0")
 
 
 def match(topo: TopoMap, vector: np.ndarray, top: int = TOP) -> list[tuple[int, float]]:
@@ -118,9 +128,7 @@ def localize_queries(
     return out
 
 
-def retrieval(
-    localizer: Localizer, maps: list[TopoMap], data: Path, split: str
-) -> dict[str, Any]:
+def retrieval(localizer: Localizer, maps: list[TopoMap], data: Path, split: str) -> dict[str, Any]:
     """Recall@1 / @5 of the true sub-node for the split's views in other layouts.
 
     Raises:
@@ -153,13 +161,13 @@ def retrieval(
                 boxes[q["layout"]] = layout_boxes(data, room_id, q["layout"])
             moved = moved_instances(boxes[topo.layout], boxes[q["layout"]])
             true_row = topo.index((q["grid_i"], q["grid_j"], q["heading"]))
-            ranked = [k for k, _ in match(topo, vector, TOP)]
+            recall = recall_at_k((topo.embeddings @ vector)[None], np.array([true_row]), (1, 5))
             rows.append(
                 {
                     "query": q["obs_id"],
                     "moved_in_view": len(moved & {o["instance"] for o in q["objects"]}),
-                    "rank1": ranked[0] == true_row,
-                    "rank5": true_row in ranked,
+                    "rank1": bool(recall[1]),
+                    "rank5": bool(recall[5]),
                     "true_similarity": float(topo.embeddings[true_row] @ vector),
                 }
             )
@@ -178,7 +186,7 @@ def _summarise(rows: list[dict[str, Any]], epsilon: float, split: str) -> dict[s
             else None,
         }
 
-    by_bin = {b: block([r for r in rows if moved_bin(r["moved_in_view"]) == b]) for b in MOVED_BINS}
+    by_bin = {b: block([r for r in rows if moved_bin(r["moved_in_view"]) == b]) for b in BIN_NAMES}
     return {"split": split, "epsilon": epsilon, **block(rows), "by_moved": by_bin, "rows": rows}
 
 
@@ -212,8 +220,13 @@ def run_localize(
         raise MapError(f"{paths[0]}/map.json: data {str(source)!r} is not a dataset any more")
     localizer = load_localizer(run, source, epsilon=epsilon)
     maps = _open_maps(localizer, paths)
-    head = {"run": str(run), "model": localizer.name, "epsilon": localizer.epsilon,
-            "epsilon_source": localizer.epsilon_source, "maps": [str(p) for p in paths]}  # fmt: skip
+    head = {
+        "run": str(run),
+        "model": localizer.name,
+        "epsilon": localizer.epsilon,
+        "epsilon_source": localizer.epsilon_source,
+        "maps": [str(p) for p in paths],
+    }
     if queries is not None:
         result = {**head, "queries": localize_queries(localizer, maps, data, queries, top=top)}
         name, text = "localize", _queries_markdown(result)

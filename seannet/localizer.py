@@ -47,7 +47,7 @@ class Localizer:
     @property
     def transform(self) -> ImageTransform:
         """The run's image transform (its input size)."""
-        return ImageTransform(size=self.config.image_size)
+        return ImageTransform.for_model(self.config.image_size, self.config.image_family)
 
     @torch.no_grad()
     def embed(self, views: Sequence[ViewTensors]) -> np.ndarray:

@@ -68,9 +68,10 @@ def map_nodes(reachable: np.ndarray, spacing: int) -> list[tuple[int, int]]:
     if spacing < 1:
         raise MapError(f"map spacing {spacing}: expected >= 1 cell")
     return [
-        (int(i), int(j)) for i, j in zip(*np.nonzero(reachable), strict=True)
+        (int(i), int(j))
+        for i, j in zip(*np.nonzero(reachable), strict=True)
         if i % spacing == 0 and j % spacing == 0
-    ]  # fmt: skip
+    ]
 
 
 def translation_edges(
@@ -146,10 +147,11 @@ class TopoMap:
         if self._graph is None:
             g = nx.Graph()
             g.add_nodes_from(self.sub_nodes())
-            for i, j in {(a, b) for a, b, _ in self.sub_nodes()}:
+            for i, j in sorted({(a, b) for a, b, _ in self.sub_nodes()}):
                 for h in range(HEADINGS):
-                    g.add_edge((i, j, h), (i, j, (h + 1) % HEADINGS), cost=ROTATION_COST,
-                               kind="rotation")  # fmt: skip
+                    g.add_edge(
+                        (i, j, h), (i, j, (h + 1) % HEADINGS), cost=ROTATION_COST, kind="rotation"
+                    )
             for i1, j1, i2, j2 in self.meta["edges"]:
                 for h in range(HEADINGS):
                     cost = abs(i2 - i1) + abs(j2 - j1)

@@ -10,7 +10,7 @@ import torch
 from torch import Tensor, nn
 from torchvision.ops import roi_align
 
-from seannet.backbones import ENCODER_NAMES, resnet_c4
+from seannet.backbones import ENCODER_NAMES, efficientnet_lite0_c4, resnet_c4
 from seannet.baselines import ImageEncoder
 from seannet.batch import NUM_RELATIONS, SceneBatch
 from seannet.errors import ModelError
@@ -83,6 +83,9 @@ class SeanNet(nn.Module):
         visual_features: ``"c5"`` (default) or ``"c4_head"``, see above.
         branches: ``"both"`` (default), ``"image"`` or ``"graph"``.
         object_inputs: the parts of :math:`x_i` (default ``("visual", "box", "word")``).
+        backbone: ``"resnet"`` (default, of ``depth``) or ``"efficientnet_lite0"`` (split at
+            stride 16 like C4; ``pretrained="imagenet-lite0"`` loads its ImageNet weights
+            from the optional ``lite`` extra).
 
     Shapes:
         - **batch**: a :class:`~seannet.batch.SceneBatch` with B views, K boxes, M slots
@@ -107,6 +110,7 @@ class SeanNet(nn.Module):
         visual_features: str = "c5",
         branches: str = "both",
         object_inputs: Sequence[str] = OBJECT_INPUTS,
+        backbone: str = "resnet",
     ) -> None:
         super().__init__()
         if visual_features not in VISUAL_FEATURES:
@@ -119,7 +123,12 @@ class SeanNet(nn.Module):
             raise ModelError(f"roi_size={roi_size}; expected a positive integer")
         if embed_dim <= 0:
             raise ModelError(f"embed_dim={embed_dim}; expected a positive integer")
-        split = resnet_c4(depth, pretrained=pretrained, sha256=pretrained_sha256)
+        if backbone == "efficientnet_lite0":
+            split = efficientnet_lite0_c4(pretrained=pretrained, sha256=pretrained_sha256)
+        elif backbone == "resnet":
+            split = resnet_c4(depth, pretrained=pretrained, sha256=pretrained_sha256)
+        else:
+            raise ModelError(f"backbone={backbone!r}; expected 'resnet' or 'efficientnet_lite0'")
         self.depth = depth
         self.num_slots = num_slots
         self.roi_size = roi_size
@@ -232,6 +241,7 @@ def build_model(
     pretrained: Path | None = None,
     pretrained_sha256: str | None = None,
     visual_features: str = "c5",
+    backbone: str = "resnet",
 ) -> SeanNet | ImageEncoder:
     """SeanNet or an image baseline by name; every model has ``embed(batch) -> (B, D)``.
 
@@ -248,6 +258,7 @@ def build_model(
         pretrained: a local torchvision state_dict file (default: random init, no download).
         pretrained_sha256: its expected SHA-256 (default: torchvision's known weights).
         visual_features: how SeanNet computes :math:`x_v` (see :class:`SeanNet`).
+        backbone: SeanNet's image network (see :class:`SeanNet`).
 
     Raises:
         ModelError: an unknown name or a bad hyper-parameter or weights file.
@@ -277,5 +288,6 @@ def build_model(
         pretrained=pretrained,
         pretrained_sha256=pretrained_sha256,
         visual_features=visual_features,
+        backbone=backbone,
         **ABLATIONS.get(name, {}),
     )

@@ -82,17 +82,24 @@ def run_navigation(
     if not rooms:
         raise NavigationError(f"{data}: split {split!r} has no room to navigate in")
     say = progress or (lambda _: None)
-    results: dict[str, Any] = {"split": split, "episodes_per_case_and_room": episodes,
-                               "seed": seed, "k_max": k_max, "spacing": spacing,
-                               "navigator": str(navigator), "runs": []}  # fmt: skip
+    results: dict[str, Any] = {
+        "split": split,
+        "episodes_per_case_and_room": episodes,
+        "seed": seed,
+        "k_max": k_max,
+        "spacing": spacing,
+        "navigator": str(navigator),
+        "runs": [],
+    }
     with LiveRooms(data) as live:
         for run in runs:
             localizer = load_localizer(run, data, epsilon=epsilon)
             records: list[dict[str, Any]] = []
             for r, room_id in enumerate(rooms):
                 say(f"{run.name}: map of {room_id}")
-                topo = ensure_map(localizer, live, room_id, maps / run.name / room_id,
-                                  spacing=spacing)  # fmt: skip
+                topo = ensure_map(
+                    localizer, live, room_id, maps / run.name / room_id, spacing=spacing
+                )
                 for case in CASES:
                     for index in range(episodes):
                         rng = rng_for(episode_seed(seed, room_id, case, index))
@@ -105,12 +112,19 @@ def run_navigation(
                         records.append(result.to_dict())
                         if keep and strips is not None:
                             name = f"{room_id}_{case}_{index}.png"
-                            save_png(draw_strip(result, topo.image(episode.path[-1])),
-                                     strips / run.name / name)  # fmt: skip
+                            save_png(
+                                draw_strip(result, topo.image(episode.path[-1])),
+                                strips / run.name / name,
+                            )
             results["runs"].append(
-                {"run": str(run), "model": localizer.name, "epsilon": localizer.epsilon,
-                 "epsilon_source": localizer.epsilon_source, "table": _rates(records),
-                 "episodes": records}  # fmt: skip
+                {
+                    "run": str(run),
+                    "model": localizer.name,
+                    "epsilon": localizer.epsilon,
+                    "epsilon_source": localizer.epsilon_source,
+                    "table": _rates(records),
+                    "episodes": records,
+                }
             )
     out.mkdir(parents=True, exist_ok=True)
     atomic_write_text(out / f"navigate_{split}.json", json.dumps(results, indent=2))
@@ -136,15 +150,24 @@ def table_rows(results: dict[str, Any]) -> list[list[str]]:
     rows = []
     for run in results["runs"]:
         t = run["table"]
-        cells = [f"{run['model']} ({Path(run['run']).name})", f"{t['N']['total']} / {t['A']['total']}"]
+        cells = [
+            f"{run['model']} ({Path(run['run']).name})",
+            f"{t['N']['total']} / {t['A']['total']}",
+        ]
         for outcome in ("success", *FAILURES):
             cells.append(f"{t['N'][outcome]:.1f} / {t['A'][outcome]:.1f}")
         rows.append(cells)
     return rows
 
 
-HEADER = ["localizer", "total cases N / A", "success % N / A", "navigation % N / A",
-          "localization % N / A", "collision % N / A"]  # fmt: skip
+HEADER = [
+    "localizer",
+    "total cases N / A",
+    "success % N / A",
+    "navigation % N / A",
+    "localization % N / A",
+    "collision % N / A",
+]
 
 
 def _markdown(results: dict[str, Any]) -> str:
@@ -161,8 +184,10 @@ def _markdown(results: dict[str, Any]) -> str:
         "",
         "| localizer | epsilon | from |",
         "|---|---|---|",
-        *(f"| {r['model']} ({Path(r['run']).name}) | {r['epsilon']:.3f} | {r['epsilon_source']} |"
-          for r in results["runs"]),  # fmt: skip
+        *(
+            f"| {r['model']} ({Path(r['run']).name}) | {r['epsilon']:.3f} | {r['epsilon_source']} |"
+            for r in results["runs"]
+        ),
     ]
     return "\n".join(lines) + "\n"
 
@@ -180,8 +205,10 @@ def draw_strip(result: EpisodeResult, goal: np.ndarray) -> Image.Image:
     image = Image.new("RGB", (len(frames) * (size + 4) + 4, size + top + 18), "white")
     draw = ImageDraw.Draw(image)
     font = ImageFont.load_default(size=11)
-    title = (f"{e.room_id} layout {e.layout} case {e.case} #{e.index}: {result.outcome} "
-             f"({len(e.path) - 1} segments)")  # fmt: skip
+    title = (
+        f"{e.room_id} layout {e.layout} case {e.case} #{e.index}: {result.outcome} "
+        f"({len(e.path) - 1} segments)"
+    )
     draw.text((4, 4), title, fill="black", font=font)
     for k, (rgb, label) in enumerate(frames):
         x = 4 + k * (size + 4)

@@ -91,12 +91,16 @@ class VisualNavigator(nn.Module):
         self.encoder_name = encoder
         self.encoder, width = image_encoder(encoder, pretrained=pretrained)
         self.head = nn.Sequential(
-            nn.Linear(2 * width, hidden), nn.ReLU(inplace=True), nn.Linear(hidden, len(NAVIGATOR_ACTIONS))
-        )  # fmt: skip
+            nn.Linear(2 * width, hidden),
+            nn.ReLU(inplace=True),
+            nn.Linear(hidden, len(NAVIGATOR_ACTIONS)),
+        )
 
     def forward(self, current: Tensor, goal: Tensor) -> Tensor:
         if current.shape != goal.shape:
-            raise ModelError(f"navigator views differ: {tuple(current.shape)} vs {tuple(goal.shape)}")
+            raise ModelError(
+                f"navigator views differ: {tuple(current.shape)} vs {tuple(goal.shape)}"
+            )
         features = self.encoder(torch.cat([current, goal]))  # one pass, shared weights
         a, b = features.chunk(2)
         return self.head(torch.cat([a, b], dim=1))

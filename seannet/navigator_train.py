@@ -72,8 +72,12 @@ def render_pairs(
         for layout in sorted(set(wanted)):
             live.load(room_id, layout)
             for _ in range(wanted.count(layout)):
-                pair = draw_pair(live.grid.reachable, rng, max_side=config.max_side,
-                                 max_forward=config.max_forward)  # fmt: skip
+                pair = draw_pair(
+                    live.grid.reachable,
+                    rng,
+                    max_side=config.max_side,
+                    max_forward=config.max_forward,
+                )
                 if pair is not None:
                     draws.append((room_id, layout, *pair))
     if not draws:
@@ -149,11 +153,23 @@ def train_navigator(
         train_acc = correct / max(seen, 1)
         val_acc = accuracy(model, val_set, config, device) if val_set is not None else train_acc
         history.append(
-            {"epoch": epoch, "train_loss": total / max(seen, 1), "train_accuracy": train_acc,
-             "val_accuracy": val_acc, "seconds": time.perf_counter() - started}
-        )  # fmt: skip
-        state = {"kind": KIND, "config": config.to_dict(), "dataset": identity, "epoch": epoch,
-                 "model": model.state_dict(), "history": history, "best": max(best, val_acc)}  # fmt: skip
+            {
+                "epoch": epoch,
+                "train_loss": total / max(seen, 1),
+                "train_accuracy": train_acc,
+                "val_accuracy": val_acc,
+                "seconds": time.perf_counter() - started,
+            }
+        )
+        state = {
+            "kind": KIND,
+            "config": config.to_dict(),
+            "dataset": identity,
+            "epoch": epoch,
+            "model": model.state_dict(),
+            "history": history,
+            "best": max(best, val_acc),
+        }
         if val_acc > best:
             best = val_acc
             save_checkpoint(out / BEST, state)
@@ -203,7 +219,9 @@ def load_navigator(run: Path) -> Policy:
     path = run / BEST
     state = load_checkpoint(path)
     if state.get("kind") != KIND:
-        raise CheckpointError(f"{path}: not a navigator checkpoint (train one with train-navigator)")
+        raise CheckpointError(
+            f"{path}: not a navigator checkpoint (train one with train-navigator)"
+        )
     config = NavigatorConfig(**state["config"])
     device = device_for_run()
     model = VisualNavigator(config.encoder, hidden=config.hidden).to(device)

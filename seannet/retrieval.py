@@ -24,6 +24,7 @@ from sgdata.dataset import Dataset
 
 __all__ = [
     "MOVED_BINS",
+    "MOVE_TOLERANCE",
     "recall_at_k",
     "map_recall",
     "moved_objects",
@@ -32,7 +33,7 @@ __all__ = [
 ]
 
 MOVED_BINS = ((0, 0), (1, 2), (3, 5), (6, None))  # inclusive ranges of moved objects in view
-_MOVED_EPS = 0.01  # metres: a box corner that shifted more than this moved
+MOVE_TOLERANCE = 0.01  # metres: a box corner that shifted more than this moved
 
 
 def recall_at_k(sim: np.ndarray, truth: np.ndarray, ks: Sequence[int] = (1, 5)) -> dict[int, float]:
@@ -116,7 +117,7 @@ def moved_objects(data: Path, split: str, triplets: Sequence[tuple[str, str, str
         moved = sum(
             1
             for k in both
-            if a[k].shape == p[k].shape and a[k].size and np.abs(a[k] - p[k]).max() > _MOVED_EPS
+            if a[k].shape == p[k].shape and a[k].size and np.abs(a[k] - p[k]).max() > MOVE_TOLERANCE
         )
         if pose_of[anchor] == pose_of[positive]:
             moved += len(a.keys() ^ p.keys())

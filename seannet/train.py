@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import torch
 from torch.utils.data import DataLoader, Subset
 
@@ -75,6 +76,7 @@ def build_for_dataset(  # noqa: ANN201
         pretrained=pretrained,
         pretrained_sha256=pretrained_sha256,
         visual_features=config.visual_features,
+        backbone=config.backbone,
     )
 
 
@@ -114,7 +116,7 @@ def train(
     """
     check_pretrained_request(pretrained, pretrained_sha256)
     identity = dataset_identity(data)
-    transform = ImageTransform(size=config.image_size)
+    transform = ImageTransform.for_model(config.image_size, config.image_family)
     train_set = TripletDataset(data, "train", transform=transform)
     val_set = TripletDataset(data, "val", transform=transform)
     device = device_for_run()
@@ -222,9 +224,14 @@ def evaluate_triplets(
     device: torch.device,
     progress: Callable[[str, int, int, dict[str, float]], None] | None = None,
 ) -> float:
-    """Share of triplets with S(A, P) > S(A, N)."""
+    """Share of triplets with S(A, P) > S(A, N) (on ``config.max_val_triplets`` of them,
+    evenly spaced over the split, when that is set)."""
+    subset: torch.utils.data.Dataset = dataset
+    if 0 < config.max_val_triplets < len(dataset):
+        picks = np.unique(np.linspace(0, len(dataset) - 1, config.max_val_triplets).round())
+        subset = torch.utils.data.Subset(dataset, picks.astype(int).tolist())
     loader = DataLoader(
-        dataset,
+        subset,
         batch_size=config.batch_size,
         collate_fn=collate_triplets,
         num_workers=config.num_workers,

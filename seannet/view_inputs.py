@@ -19,6 +19,9 @@ from sgdata.annotate.relations import RelationType
 __all__ = [
     "IMAGENET_MEAN",
     "IMAGENET_STD",
+    "LITE0_MEAN",
+    "LITE0_STD",
+    "NORMALISATION",
     "ImageTransform",
     "dense_adjacency",
     "graph_from_columns",
@@ -29,6 +32,15 @@ __all__ = [
 # torchvision's ImageNet statistics (RGB, on [0, 1] pixels): what the pretrained ResNet saw.
 IMAGENET_MEAN = (0.485, 0.456, 0.406)
 IMAGENET_STD = (0.229, 0.224, 0.225)
+# The TensorFlow EfficientNet-Lite checkpoints the Lite0 weights were converted from saw pixels
+# scaled to [-1, 1] ((x - 127) / 128 on 0..255; tensorflow/tpu efficientnet_lite_builder.py).
+LITE0_MEAN = (127 / 255, 127 / 255, 127 / 255)
+LITE0_STD = (128 / 255, 128 / 255, 128 / 255)
+# input normalisation by backbone family (TrainConfig.backbone)
+NORMALISATION = {
+    "resnet": (IMAGENET_MEAN, IMAGENET_STD),
+    "efficientnet_lite0": (LITE0_MEAN, LITE0_STD),
+}
 
 
 # ---------------------------------------------------------------------------------- images
@@ -57,6 +69,12 @@ class ImageTransform:
             raise DataError(f"ImageTransform mean/std {self.mean}/{self.std}; expected 3 each")
         if min(self.std) <= 0:
             raise DataError(f"ImageTransform std={self.std}; expected positive values")
+
+    @classmethod
+    def for_model(cls, image_size: int, backbone: str = "resnet") -> ImageTransform:
+        """The transform a model expects: its input size and its backbone's normalisation."""
+        mean, std = NORMALISATION[backbone]
+        return cls(size=image_size, mean=mean, std=std)
 
     def __call__(self, rgb: np.ndarray, boxes: np.ndarray) -> tuple[Tensor, Tensor]:
         """Transform one view.

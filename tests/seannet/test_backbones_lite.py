@@ -142,3 +142,32 @@ def test_missing_weights_package_is_one_line_model_error(monkeypatch: pytest.Mon
     with pytest.raises(ModelError) as info:
         efficientnet_lite0_c4(pretrained=LITE0_WEIGHTS)
     assert "\n" not in str(info.value) and "not installed" in str(info.value)
+
+
+def test_seannet_on_the_lite0_backbone_embeds_and_normalises_its_way() -> None:
+    from seannet.config import TrainConfig
+    from seannet.model import build_model
+    from seannet.view_inputs import LITE0_MEAN, ImageTransform
+
+    torch.manual_seed(0)
+    model = build_model(
+        "seannet",
+        num_slots=16,
+        embed_dim=64,
+        backbone="efficientnet_lite0",
+        pretrained=LITE0_WEIGHTS,
+    ).eval()
+    batch = SceneBatch(
+        images=torch.randn(2, 3, 112, 112),
+        boxes=torch.tensor([[8.0, 8.0, 60.0, 70.0], [30.0, 40.0, 100.0, 100.0]]),
+        box_view=torch.tensor([0, 1]),
+        class_ids=torch.tensor([1, 2]),
+        slots=torch.tensor([3, 5]),
+        adjacency=torch.eye(16).expand(2, 3, 16, 16).clone(),
+    )
+    with torch.no_grad():
+        out = model.embed(batch)
+    assert out.shape == (2, 64) and torch.isfinite(out).all()
+    config = TrainConfig(backbone="efficientnet_lite0")
+    transform = ImageTransform.for_model(112, config.image_family)
+    assert transform.mean == LITE0_MEAN

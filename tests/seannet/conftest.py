@@ -1,0 +1,29 @@
+"""Fixtures of the localization and navigation tests: a tiny trained localizer run."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from seannet.config import TrainConfig
+from seannet.train import train
+
+# A localizer run in seconds: the ResNet-18 baseline at 64 px, one batch of two triplets.
+TINY_LOCALIZER = TrainConfig(
+    model="resnet18",
+    image_size=64,
+    embed_dim=64,
+    epochs=1,
+    batch_size=2,
+    max_train_batches=1,
+    num_workers=0,
+)
+
+
+@pytest.fixture(scope="session")
+def localizer_run(tmp_path_factory: pytest.TempPathFactory, mini_dataset: Path) -> Path:
+    """A run directory (best.pt) trained on the mini dataset; no eval file, so no epsilon."""
+    run = tmp_path_factory.mktemp("localizer") / "run"
+    train(TINY_LOCALIZER, mini_dataset, run)
+    return run
