@@ -16,7 +16,7 @@ from pxr import Usd, UsdGeom
 
 from sgdata.usd.gprims import tessellate_gprim
 from sgdata.usd.meshes import MeshData, ObjectGeometry, SceneGeometry, merge_meshes
-from sgdata.usd.object_prims import drawn, instance_ids, is_object
+from sgdata.usd.object_prims import drawn_prims, instance_ids, is_object
 from sgdata.usd.room_io import open_stage
 from sgdata.usd.stage_frame import stage_frame
 from sgdata.world.scene import transform_points
@@ -50,11 +50,7 @@ def stage_geometry(stage: Usd.Stage, path: Path) -> SceneGeometry:
     owners: dict[str, Usd.Prim] = {}  # object prim path -> prim, in traversal order
     parts: dict[str, list[MeshData]] = {}
     structure = []
-    prims = iter(Usd.PrimRange.Stage(stage, Usd.TraverseInstanceProxies()))
-    for prim in prims:
-        if not drawn(prim):
-            prims.PruneChildren()  # type: ignore[attr-defined]
-            continue
+    for prim in drawn_prims(stage):
         if is_object(prim):
             owners[str(prim.GetPath())] = prim
             parts.setdefault(str(prim.GetPath()), [])

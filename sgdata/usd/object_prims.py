@@ -7,13 +7,14 @@ above the largest authored id, so the same stage always gets the same ids.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from pathlib import Path
 
 from pxr import Usd, UsdGeom
 
 from sgdata.errors import UsdError
 
-__all__ = ["is_object", "drawn", "object_prims", "instance_ids"]
+__all__ = ["is_object", "drawn", "drawn_prims", "object_prims", "instance_ids"]
 
 
 def is_object(prim: Usd.Prim) -> bool:
@@ -31,17 +32,20 @@ def drawn(prim: Usd.Prim) -> bool:
     return imageable.GetPurposeAttr().Get() not in (UsdGeom.Tokens.guide, UsdGeom.Tokens.proxy)
 
 
-def object_prims(stage: Usd.Stage) -> list[Usd.Prim]:
-    """The drawn object prims of a composed stage, in traversal order."""
-    found = []
+def drawn_prims(stage: Usd.Stage) -> Iterator[Usd.Prim]:
+    """Every drawn prim of a composed stage in traversal order (hidden subtrees pruned,
+    instance proxies followed)."""
     prims = iter(Usd.PrimRange.Stage(stage, Usd.TraverseInstanceProxies()))
     for prim in prims:
         if not drawn(prim):
             prims.PruneChildren()  # type: ignore[attr-defined]
             continue
-        if is_object(prim):
-            found.append(prim)
-    return found
+        yield prim
+
+
+def object_prims(stage: Usd.Stage) -> list[Usd.Prim]:
+    """The drawn object prims of a composed stage, in traversal order."""
+    return [prim for prim in drawn_prims(stage) if is_object(prim)]
 
 
 def instance_ids(path: Path, prims: list[Usd.Prim]) -> dict[str, int]:
