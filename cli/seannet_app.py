@@ -127,9 +127,13 @@ def compare(
     budget: Annotated[
         float | None, typer.Option(help="Training seconds per run (same for every model).")
     ] = None,
+    batches: Annotated[
+        int | None, typer.Option(help="Batches per epoch for every model (instead of --budget).")
+    ] = None,
 ) -> None:
     """Train every model under one budget, pick its lr on val, repeat over seeds, one table."""
     from seannet.compare import COMPARISON, compare_models
+    from seannet.config import preset as load_preset
 
     try:
         seed_list = [int(s) for s in seeds.split(",") if s.strip()]
@@ -137,11 +141,14 @@ def compare(
     except ValueError:
         raise typer.BadParameter("--seeds takes integers, --lrs numbers, comma-separated") from None
     names = [m.strip() for m in models.split(",") if m.strip()]
+    base = load_preset(preset)
+    if batches is not None:
+        base = base.replace(max_train_batches=batches)
     compare_models(
         data,
         out,
         names,
-        preset=preset,
+        preset=base if batches is not None else preset,
         split=split,
         seeds=seed_list,
         lrs=lr_list,
