@@ -78,14 +78,22 @@ def sample_poses(room: Room, count: int, rng: np.random.Generator) -> list[ViewP
 
 class NaivePyrender:
     """pyrender used as its documentation shows: the structure and one node per object (its
-    local mesh under its pose), two lights, an RGB pass and a SEG pass (instance colours)."""
+    local mesh under its pose), two lights, an RGB pass and a SEG pass (instance colours).
 
-    def __init__(self, camera: CameraConfig, geometry: SceneGeometry) -> None:
+    Its GL context lives as long as the process: pyrender's ``delete`` terminates the EGL
+    display every renderer of the process shares.
+    """
+
+    def __init__(self, camera: CameraConfig) -> None:
         import pyrender as pr
 
+        self.camera, self.pr = camera, pr
+        self.gl = pr.OffscreenRenderer(camera.width, camera.height)
+
+    def load(self, geometry: SceneGeometry) -> None:
         from sgdata.render.renderer import _ceiling_light_pose, _primitive
 
-        self.camera = camera
+        pr, camera = self.pr, self.camera
         scene = pr.Scene(bg_color=[0.45, 0.45, 0.48, 1.0], ambient_light=[0.35] * 3)
         seg = {}
         for m in geometry.structure:
@@ -100,17 +108,12 @@ class NaivePyrender:
             pr.PointLight(color=np.ones(3), intensity=6.0), pose=_ceiling_light_pose(geometry)
         )
         self.scene, self.seg = scene, seg
-        self.gl = pr.OffscreenRenderer(camera.width, camera.height)
-        self.flags = pr.RenderFlags
 
     def view(self, pose: ViewPose) -> tuple[np.ndarray, np.ndarray]:
         self.scene.set_pose(self.cam_node, self.camera.pose_matrix(pose.x, pose.y, pose.theta))
         rgb, _ = self.gl.render(self.scene)
-        ids, _ = self.gl.render(self.scene, flags=self.flags.SEG, seg_node_map=self.seg)
+        ids, _ = self.gl.render(self.scene, flags=self.pr.RenderFlags.SEG, seg_node_map=self.seg)
         return rgb, ids
-
-    def close(self) -> None:
-        self.gl.delete()
 
 
 def rate(fn: Callable[[ViewPose], object], poses: list[ViewPose]) -> float:
@@ -135,6 +138,7 @@ def main() -> None:
     classes = sorted({o.class_name for room, _ in scenes for o in room.objects})
     slots = SlotTable.from_counts([(c, 8) for c in classes], num_slots=max(256, 8 * len(classes)))
     renderer = Renderer(id_pass=args.id_pass)
+    naive = NaivePyrender(renderer.camera)
     annotator = ViewAnnotator(renderer, slots)
     rng = np.random.default_rng(args.seed)
     keys = ("rgb", "ids", "rgb+ids", "pipeline", "naive")
@@ -151,9 +155,8 @@ def main() -> None:
             "rgb+ids": rate(lambda p: renderer.render(p.x, p.y, p.theta), poses),
             "pipeline": rate(lambda p: annotator.view(p), poses),
         }
-        naive = NaivePyrender(renderer.camera, geometry)
+        naive.load(geometry)
         fps["naive"] = rate(naive.view, poses)
-        naive.close()
         for key, value in fps.items():
             totals[key].append(value)
         objs = len(geometry.objects)

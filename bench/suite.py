@@ -1,7 +1,7 @@
 """Every benchmark of the pipeline in one run, as one table (docs/benchmarks.md).
 
     .venv/bin/python bench/suite.py                      # ~10 min on 2 cores
-    .venv/bin/python bench/suite.py --rooms 8 --views 30 --validate out/small
+    .venv/bin/python bench/suite.py --rooms 24 --views 30 --validate out/medium
 
 Rows, each measured in a fresh process on this machine, one after the other:
 
@@ -39,7 +39,7 @@ def _json_line(command: list[str], env: dict | None = None) -> dict:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--rooms", type=int, default=8, help="rooms of the generate runs")
+    parser.add_argument("--rooms", type=int, default=24, help="rooms of the generate runs")
     parser.add_argument("--views", type=int, default=30, help="views per room of the render run")
     parser.add_argument("--validate", type=Path, help="dataset to validate (default: tiny)")
     args = parser.parse_args()
