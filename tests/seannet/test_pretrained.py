@@ -96,3 +96,15 @@ def test_weights_of_another_architecture_do_not_fit(tmp_path: Path) -> None:
     torch.save(torch.nn.Linear(3, 2).state_dict(), path)
     with pytest.raises(ModelError, match=r"do not fit resnet18: \d+ missing .*2 unexpected"):
         ImageEncoder("resnet18", pretrained=path, pretrained_sha256=file_sha256(path))
+
+
+def test_an_expected_sha256_that_cannot_be_used_is_refused(tmp_path: Path) -> None:
+    """`seannet train --pretrained-sha256` was once accepted and silently ignored."""
+    from seannet.pretrained import check_pretrained_request
+
+    with pytest.raises(ModelError, match="given without --pretrained"):
+        check_pretrained_request(None, "ab" * 32)
+    with pytest.raises(ModelError, match="expected 8 to 64 hex digits"):
+        check_pretrained_request(tmp_path / "w.pth", "WRONG")
+    check_pretrained_request(tmp_path / "w.pth", "ab" * 32)  # usable: no error
+    check_pretrained_request(None, None)
