@@ -64,7 +64,9 @@ def run_tasks(
     if executor == "ray":
         run_on_ray = _ray_executor().run_on_ray
 
-        yield from run_on_ray(fn, jobs, workers=workers, address=address, retries=retries)
+        yield from run_on_ray(
+            fn, jobs, workers=workers, address=address, retries=retries, env=WORKER_ENV
+        )
         return
     yield from _run_local(fn, jobs, workers=workers)
 
@@ -77,7 +79,7 @@ def executor_session(executor: str, *, workers: int, address: str | None) -> Ite
     if executor != "ray":
         yield
         return
-    with _ray_executor().ray_session(address, workers):
+    with _ray_executor().ray_session(address, workers, WORKER_ENV):
         yield
 
 

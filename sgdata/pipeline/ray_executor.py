@@ -18,7 +18,6 @@ import ray
 from ray.exceptions import RayActorError, RayTaskError, WorkerCrashedError
 
 from sgdata.errors import SgdataError, WorkerError
-from sgdata.pipeline.executors import WORKER_ENV
 from sgdata.pipeline.reaper import start_reaper
 
 __all__ = ["run_on_ray", "ray_session"]
@@ -39,6 +38,7 @@ def run_on_ray(
     workers: int,
     address: str | None,
     retries: int,
+    env: dict[str, str],
 ) -> Iterator[dict]:
     """Run ``fn(*job)`` for every job on ``workers`` actors; yield results as they finish.
 
@@ -46,7 +46,7 @@ def run_on_ray(
     then reported by name (its room id). A task that raises an ``SgdataError`` (bad input, a
     file that cannot be written) is not retried: its message is re-raised as it is.
     """
-    with ray_session(address, workers):
+    with ray_session(address, workers, env):
         yield from _run(fn, jobs, workers=workers, retries=retries)
 
 
@@ -101,14 +101,15 @@ def _retry(index: int, jobs: list[tuple], tries: Counter[int], retries: int, why
 
 
 @contextmanager
-def ray_session(address: str | None, workers: int) -> Iterator[None]:
+def ray_session(address: str | None, workers: int, env: dict[str, str]) -> Iterator[None]:
     """Ray connected for the duration: joins the cluster at ``address``, or starts a local
-    instance; shuts down only what it started (a session already open is reused)."""
+    instance, its workers getting ``env``; shuts down only what it started (a session
+    already open is reused)."""
     if ray.is_initialized():
         yield
         return
     options: dict[str, Any] = {
-        "runtime_env": {"env_vars": dict(WORKER_ENV)},
+        "runtime_env": {"env_vars": dict(env)},
         "log_to_driver": False,
         "logging_level": "ERROR",
     }

@@ -3,6 +3,11 @@
 from sgdata.lazy_face import lazy_face
 
 _EXPORTS = {
+    "check_stage": ".stage",
+    "open_layer": ".stage",
+    "open_stage": ".stage",
+    "validate_stage": ".stage",
+    "write_text_atomic": ".stage",
     "DEFAULT_COLOR": ".geometry",
     "read_geometry": ".geometry",
     "stage_geometry": ".geometry",
@@ -18,14 +23,9 @@ _EXPORTS = {
     "ROOT": ".room_io",
     "STRUCTURE": ".room_io",
     "catalog_geometry": ".room_io",
-    "check_stage": ".room_io",
     "object_path": ".room_io",
-    "open_layer": ".room_io",
-    "open_stage": ".room_io",
     "read_room": ".room_io",
-    "validate_stage": ".room_io",
     "write_room": ".room_io",
-    "write_text_atomic": ".room_io",
     "layout_indices": ".scene_dirs",
     "layout_path": ".scene_dirs",
     "load_base": ".scene_dirs",

@@ -17,7 +17,7 @@ from pxr import Usd, UsdGeom
 from sgdata.usd.gprims import tessellate_gprim
 from sgdata.usd.meshes import MeshData, ObjectGeometry, SceneGeometry, merge_meshes
 from sgdata.usd.object_prims import drawn_prims, instance_ids, is_object
-from sgdata.usd.room_io import open_stage
+from sgdata.usd.stage import open_stage
 from sgdata.usd.stage_frame import stage_frame
 from sgdata.world.scene import transform_points
 

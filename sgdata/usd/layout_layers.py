@@ -4,7 +4,7 @@ A layout layer sublayers ``./room.usda`` and holds only ``over`` specs for
 ``/Room/Objects/<prim>``: ``xformOp:translate`` and ``xformOp:rotateZ`` for an object whose
 placement differs from the room's, and ``sgdata:support`` where its support changed (an
 explicit empty target list when it now rests on the floor). Read a layout's composed room with
-:func:`sgdata.usd_io.read_room`.
+:func:`sgdata.usd.room_io.read_room`.
 
 Provenance lives in the layer's ``customLayerData``: ``sgdata:layout`` (int, the layout index),
 ``sgdata:seed`` (int64) and ``sgdata:moves``, a JSON string holding the list of move records
@@ -25,7 +25,8 @@ from pxr import Gf, Sdf, UsdGeom, Vt
 from sgdata.errors import SceneError, UsdError
 from sgdata.scene_files import ROOM_FILE
 from sgdata.usd.own_layouts import OwnFrame, override_own
-from sgdata.usd.room_io import ROOT, object_path, open_layer, write_text_atomic
+from sgdata.usd.room_io import ROOT, object_path
+from sgdata.usd.stage import open_layer, write_text_atomic
 from sgdata.world.scene import Room, SceneObject
 
 __all__ = ["PLACEMENT_TOLERANCE", "write_layout", "read_layout_provenance"]

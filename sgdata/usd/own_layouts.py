@@ -16,7 +16,7 @@ import numpy as np
 from pxr import Gf, Sdf, Usd, UsdGeom
 
 from sgdata.usd.own_rooms import is_measured, measure_stage
-from sgdata.usd.room_io import open_stage
+from sgdata.usd.stage import open_stage
 from sgdata.usd.stage_frame import room_prim, stage_frame, up_and_units
 from sgdata.world.scene import SceneObject
 

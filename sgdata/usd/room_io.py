@@ -24,15 +24,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from functools import cache
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-from pxr import Gf, Kind, Sdf, Tf, Usd, UsdGeom, UsdValidation, Vt
+from pxr import Gf, Kind, Sdf, Usd, UsdGeom, Vt
 
 from sgdata.errors import SceneError, UsdError
-from sgdata.fileio import atomic_write_text
+from sgdata.usd.stage import open_stage, write_text_atomic
 from sgdata.world.scene import WALLS, Dynamics, Opening, Placement, Room, SceneObject
 
 if TYPE_CHECKING:
@@ -47,11 +46,6 @@ __all__ = [
     "write_room",
     "read_room",
     "object_path",
-    "open_layer",
-    "open_stage",
-    "write_text_atomic",
-    "validate_stage",
-    "check_stage",
 ]
 
 ROOT = Sdf.Path("/Room")
@@ -221,22 +215,6 @@ def _int64(value: int, what: str) -> int:
     return int(value)
 
 
-def write_text_atomic(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` through a temporary file in the same folder and a rename.
-
-    Raises:
-        UsdError: the folder cannot be created or the file cannot be written.
-    """
-    path = Path(path)
-    try:
-        atomic_write_text(path, text)
-    except OSError as exc:
-        raise UsdError(f"{path}: cannot write USD file ({exc.strerror or exc})") from None
-    layer = Sdf.Layer.Find(str(path))
-    if layer is not None:  # a layer still open in this process would otherwise be stale
-        layer.Reload(force=True)
-
-
 def _box(lo: tuple[float, float, float], hi: tuple[float, float, float]) -> np.ndarray:
     """The 12 outward-wound triangles of the box [lo, hi], as an (12, 3, 3) corner array."""
     corners = np.array(
@@ -295,64 +273,6 @@ def _structure_meshes(room: Room) -> dict[str, tuple[np.ndarray, np.ndarray, np.
 
 
 # ---------------------------------------------------------------------------------- reading
-
-
-def open_layer(path: Path, what: str | None = None) -> Sdf.Layer:
-    """Open one layer (no composition) from disk, reloading a stale copy this process holds.
-
-    Raises:
-        UsdError: the file is missing or is not a readable USD layer.
-    """
-    what = what or str(path)
-    if not Path(path).is_file():
-        raise UsdError(f"{what}: USD file not found")
-    try:
-        layer = Sdf.Layer.Find(str(path))
-        if layer is not None:
-            layer.Reload()
-        else:
-            layer = Sdf.Layer.FindOrOpen(str(path))
-    except Tf.ErrorException as exc:
-        raise UsdError(f"{what}: unreadable USD layer ({_tf_message(exc)})") from None
-    if layer is None:
-        raise UsdError(f"{what}: unreadable USD layer")
-    return layer
-
-
-def _check_sublayers(layer: Sdf.Layer, where: Path, seen: set[str]) -> None:
-    for sub in layer.subLayerPaths:
-        resolved = Path(Sdf.ComputeAssetPathRelativeToLayer(layer, sub))
-        if str(resolved) in seen:
-            continue
-        seen.add(str(resolved))
-        if not resolved.is_file():
-            raise UsdError(f"{where}: sublayer {sub!r} not found (looked for {resolved})")
-        _check_sublayers(open_layer(resolved, f"{where}: sublayer {sub!r}"), where, seen)
-
-
-def open_stage(path: Path, *, strict: bool = True) -> Usd.Stage:
-    """Open a USD file as a composed stage, always from the file's current content on disk.
-
-    Args:
-        path: a ``room.usda``, a ``layout_<k>.usda`` or any USD file.
-        strict: also fail on a missing sublayer or any other composition error.
-
-    Raises:
-        UsdError: the file is missing or unreadable, or (strict) composition fails.
-    """
-    path = Path(path)
-    layer = open_layer(path)
-    if strict:
-        _check_sublayers(layer, path, {str(path.resolve())})
-    try:
-        stage = Usd.Stage.Open(layer)
-    except Tf.ErrorException as exc:
-        raise UsdError(f"{path}: cannot compose stage ({_tf_message(exc)})") from None
-    errors = stage.GetCompositionErrors() if strict else []
-    if errors:
-        kinds = sorted({type(e).__name__.removeprefix("Error") for e in errors})
-        raise UsdError(f"{path}: {len(errors)} composition error(s): {', '.join(kinds)}")
-    return stage
 
 
 def read_room(path: Path) -> Room:
@@ -465,46 +385,3 @@ def _float3(value: object) -> tuple[float, float, float]:
 
 
 # ------------------------------------------------------------------------------- validation
-
-
-@cache
-def _validators() -> tuple[UsdValidation.Validator, ...]:
-    registry = UsdValidation.ValidationRegistry()
-    names = [m.name for m in registry.GetAllValidatorMetadata() if not m.isSuite]
-    return tuple(registry.GetOrLoadValidatorsByName(sorted(names)))
-
-
-def validate_stage(path: Path) -> list[str]:
-    """Run every validator registered with ``pxr.UsdValidation`` on the composed stage.
-
-    Returns:
-        one line per problem found (errors, warnings and notes alike); empty when clean.
-
-    Raises:
-        UsdError: the file is missing or unreadable (composition errors are reported, not raised).
-    """
-    stage = open_stage(path, strict=False)
-    context = UsdValidation.ValidationContext(list(_validators()))
-    errors = context.Validate(stage)
-    return [_one_line(e.GetErrorAsString()) for e in errors if not e.HasNoError()]
-
-
-def check_stage(path: Path) -> None:
-    """Validate ``path`` like :func:`validate_stage` and raise when anything is reported.
-
-    Raises:
-        UsdError: naming the file, the number of problems and the first of them.
-    """
-    problems = validate_stage(path)
-    if problems:
-        more = f" (and {len(problems) - 1} more)" if len(problems) > 1 else ""
-        raise UsdError(f"{path}: fails USD validation: {problems[0]}{more}")
-
-
-def _tf_message(exc: Tf.ErrorException) -> str:
-    text = " ".join(str(exc).split())
-    return (text.split(" : ", 1)[-1] if " : " in text else text).strip("' ")
-
-
-def _one_line(text: str) -> str:
-    return " ".join(text.split())

@@ -1,5 +1,5 @@
 """Scene checks: every USD layer a row's ``scene`` names exists and composes; with ``usd``,
-USD's own validators run on it too (:func:`sgdata.usd.room_io.validate_stage`)."""
+USD's own validators run on it too (:func:`sgdata.usd.stage.validate_stage`)."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ __all__ = ["check_scenes"]
 
 def check_scenes(root: Path, splits: list[SplitTables], out: Collector, *, usd: bool) -> None:
     """Open each distinct referenced scene once; report problems at its first row."""
-    from sgdata.usd.room_io import open_stage, validate_stage  # pxr only when scenes are checked
+    from sgdata.usd.stage import open_stage, validate_stage  # pxr only when scenes are checked
 
     first: dict[str, tuple[str, int]] = {}
     for tables in splits:

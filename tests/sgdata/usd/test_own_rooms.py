@@ -11,8 +11,9 @@ from pxr import Gf, Sdf, Usd, UsdGeom, Vt
 
 from sgdata.errors import UsdError
 from sgdata.usd.geometry import read_geometry
-from sgdata.usd.room_io import read_room, validate_stage
+from sgdata.usd.room_io import read_room
 from sgdata.usd.scene_dirs import load_layout, write_layouts
+from sgdata.usd.stage import validate_stage
 from sgdata.usd.tagging import tag_stage
 
 # the room in room-frame metres: interior x in [-2, 2], y in [-1.5, 1.5], 2.5 m high, a door

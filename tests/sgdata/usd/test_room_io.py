@@ -13,7 +13,8 @@ from pxr import Gf, Sdf, Usd, UsdGeom, Vt
 from sgdata.errors import UsdError
 from sgdata.usd.geometry import read_geometry
 from sgdata.usd.layout_layers import read_layout_provenance, write_layout
-from sgdata.usd.room_io import catalog_geometry, check_stage, read_room, validate_stage, write_room
+from sgdata.usd.room_io import catalog_geometry, read_room, write_room
+from sgdata.usd.stage import check_stage, validate_stage
 from sgdata.world.catalog import Catalog, ClassSpec
 from sgdata.world.scene import Dynamics, Opening, Placement, Room, SceneObject
 from sgdata.world.shapes import build_shape, merged_mesh

@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 
 from sgdata.errors import ConfigError, SceneError, SgdataError
-from sgdata.usd.room_io import read_room, validate_stage
+from sgdata.usd.room_io import read_room
 from sgdata.usd.scene_dirs import layout_file, load_layout, write_layouts
+from sgdata.usd.stage import validate_stage
 from sgdata.world.catalog import Catalog
 from sgdata.world.dynamics import DynamicsConfig, bounding_radius, sample_layouts, summarize_layouts
 from sgdata.world.room_checks import room_problems

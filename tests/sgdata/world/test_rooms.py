@@ -10,8 +10,9 @@ import pytest
 import trimesh
 
 from sgdata.errors import ConfigError
-from sgdata.usd.room_io import read_room, validate_stage
+from sgdata.usd.room_io import read_room
 from sgdata.usd.scene_dirs import write_rooms
+from sgdata.usd.stage import validate_stage
 from sgdata.world.catalog import Catalog
 from sgdata.world.placement import ancestors
 from sgdata.world.room_checks import room_problems
