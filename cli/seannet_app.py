@@ -35,7 +35,7 @@ def train(
             "| vgg16 | googlenet | efficientnet_lite0"
         ),
     ] = "seannet",
-    preset: Annotated[str, typer.Option(help="cpu | paper")] = "cpu",
+    preset: Annotated[str, typer.Option(help="cpu | gpu | paper")] = "cpu",
     backbone: Annotated[
         str | None, typer.Option(help="SeanNet's image network: resnet | efficientnet_lite0.")
     ] = None,
@@ -115,9 +115,13 @@ def compare(
     data: Data,
     out: Annotated[Path, typer.Option("--out", help="Directory for the runs and the tables.")],
     models: Annotated[
-        str, typer.Option(help="Comma-separated models (seannet, seannet-graph, resnet18, ...).")
+        str,
+        typer.Option(
+            help="Comma-separated specs NAME[@lite0][+imagenet]: seannet, seannet-graph, "
+            "resnet18, seannet@lite0+imagenet, efficientnet_lite0+imagenet, ..."
+        ),
     ] = "seannet,resnet18",
-    preset: Annotated[str, typer.Option(help="cpu | paper")] = "cpu",
+    preset: Annotated[str, typer.Option(help="cpu | gpu | paper")] = "cpu",
     split: Annotated[str, typer.Option(help="Split to compare on.")] = "test",
     seeds: Annotated[str, typer.Option(help="Comma-separated training seeds.")] = "0",
     lrs: Annotated[

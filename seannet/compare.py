@@ -7,6 +7,11 @@ Fairness, as measured rather than assumed: every model gets the same *seconds* o
 the batch count that budget buys is recorded, so a rerun with the recorded figures trains
 exactly the same. The learning rate of each model is the best of ``lrs`` on the validation
 split (seed 0), and the seeds reuse it.
+
+A model is named by a spec ``NAME[@lite0][+imagenet]``: ``NAME`` a model or ablation
+(``seannet``, ``seannet-graph``, ``resnet18``, ``efficientnet_lite0``, ...), ``@lite0`` puts
+SeanNet on the EfficientNet-Lite0 image network, ``+imagenet`` starts that network from the
+ImageNet weights that install offline (the `lite` extra), e.g. ``seannet@lite0+imagenet``.
 """
 
 from __future__ import annotations
@@ -23,19 +28,43 @@ import torch
 from scipy import stats
 from torch.utils.data import DataLoader
 
+from seannet.backbones import LITE0_WEIGHTS
 from seannet.config import TrainConfig
 from seannet.config import preset as load_preset
 from seannet.data import ImageTransform, TripletDataset, collate_triplets
 from seannet.errors import ModelError
 from seannet.eval_run import evaluate_run
 from seannet.loss import TripletLoss
-from seannet.train import HISTORY, LAST, build_for_dataset, param_groups, train
+from seannet.train import HISTORY, LAST, build_for_dataset, device_for_run, param_groups, train
 from sgdata.fileio import atomic_write_text
 
-__all__ = ["COMPARISON", "compare_models", "calibrate_batches", "summarize"]
+__all__ = ["COMPARISON", "compare_models", "calibrate_batches", "model_spec", "summarize"]
 
 COMPARISON = "comparison"  # comparison.json and comparison.md under the output directory
 _CALIBRATION_STEPS = 3  # timed training steps (after one warm-up) per model
+_LITE0 = "efficientnet_lite0"
+
+
+def model_spec(spec: str, base: TrainConfig) -> tuple[TrainConfig, Path | None]:
+    """The training config and ImageNet weights a spec ``NAME[@lite0][+imagenet]`` names.
+
+    Raises:
+        ModelError: ``@`` names another image network, or ``+imagenet`` asks for weights the
+            spec's image network has none of offline (only EfficientNet-Lite0 has).
+    """
+    imagenet = spec.endswith("+imagenet")
+    name, _, network = spec.removesuffix("+imagenet").partition("@")
+    config = base.replace(model=name)
+    if network:
+        if network != "lite0" or not name.startswith("seannet"):
+            raise ModelError(f"model {spec!r}: '@' takes 'lite0' after a seannet model")
+        config = config.replace(backbone=_LITE0)
+    if imagenet and config.image_family != _LITE0:
+        raise ModelError(
+            f"model {spec!r}: +imagenet needs the EfficientNet-Lite0 network "
+            f"(seannet@lite0 or {_LITE0}); no other ImageNet weights install offline"
+        )
+    return config, Path(LITE0_WEIGHTS) if imagenet else None
 
 
 def compare_models(
@@ -71,8 +100,8 @@ def compare_models(
     name_of_preset = preset if isinstance(preset, str) else "custom"
     results: dict[str, Any] = {"preset": name_of_preset, "split": split, "budget_s": budget_s}
     entries = []
-    for name in models:
-        config = base.replace(model=name)
+    specs = {name: model_spec(name, base) for name in models}  # refuse a bad spec before work
+    for name, (config, pretrained) in specs.items():
         if budget_s is not None:
             batches = calibrate_batches(config, data, budget_s)
             config = config.replace(max_train_batches=batches)
@@ -81,7 +110,7 @@ def compare_models(
         for lr in lrs or (config.lr,):
             run = _run_dir(out, name, lr, seeds[0])
             say(f"{name}: lr {lr:g}, seed {seeds[0]} -> {run}")
-            _train(config.replace(lr=lr, seed=seeds[0]), data, run)
+            _train(config.replace(lr=lr, seed=seeds[0]), data, run, pretrained)
             sweep[lr] = max(h["val_accuracy"] for h in json.loads((run / HISTORY).read_text()))
         lr = max(sweep, key=lambda k: (sweep[k], -k))  # best val accuracy; ties: the smaller
         runs = []
@@ -89,11 +118,12 @@ def compare_models(
             run = _run_dir(out, name, lr, seed)
             if seed != seeds[0]:
                 say(f"{name}: lr {lr:g}, seed {seed} -> {run}")
-                _train(config.replace(lr=lr, seed=seed), data, run)
+                _train(config.replace(lr=lr, seed=seed), data, run, pretrained)
             runs.append(evaluate_run(run, data, split=split))
         entries.append(
             {
                 "model": name,
+                "pretrained": str(pretrained) if pretrained else None,
                 "lr": lr,
                 "val_accuracy_by_lr": {f"{k:g}": v for k, v in sweep.items()},
                 "batches_per_epoch": config.max_train_batches,
@@ -113,14 +143,15 @@ def _run_dir(out: Path, name: str, lr: float, seed: int) -> Path:
     return out / name / f"lr{lr:g}" / f"seed{seed}"
 
 
-def _train(config: TrainConfig, data: Path, run: Path) -> None:
-    train(config, data, run, resume=(run / LAST).exists())
+def _train(config: TrainConfig, data: Path, run: Path, pretrained: Path | None) -> None:
+    train(config, data, run, resume=(run / LAST).exists(), pretrained=pretrained)
 
 
 def calibrate_batches(config: TrainConfig, data: Path, budget_s: float) -> int:
     """Batches per epoch that fill ``budget_s`` seconds of training, from timed steps."""
     torch.manual_seed(0)
-    model = build_for_dataset(config, data)
+    device = device_for_run()
+    model = build_for_dataset(config, data).to(device)
     optimizer = torch.optim.SGD(param_groups(model, config), lr=config.lr, momentum=0.9)
     loss_fn = TripletLoss(margin=config.margin)
     triplets = TripletDataset(
@@ -130,12 +161,14 @@ def calibrate_batches(config: TrainConfig, data: Path, budget_s: float) -> int:
     model.train()
     seconds = []
     for step in range(_CALIBRATION_STEPS + 1):
-        a, p, n, _ = next(loader)
+        a, p, n = (b.to(device) for b in next(loader)[:3])
         start = time.perf_counter()
         loss = loss_fn(model.embed(a), model.embed(p), model.embed(n))
         optimizer.zero_grad()
         loss.backward()
         optimizer.step()
+        if device.type == "cuda":
+            torch.cuda.synchronize()  # kernels run asynchronously: time them, not their launch
         if step:  # the first step pays for allocation
             seconds.append(time.perf_counter() - start)
     per_epoch = budget_s / config.epochs

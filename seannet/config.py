@@ -1,4 +1,4 @@
-"""Training configuration: presets (``cpu``, ``paper``) as frozen dataclasses."""
+"""Training configuration: presets (``cpu``, ``gpu``, ``paper``) as frozen dataclasses."""
 
 from __future__ import annotations
 
@@ -102,6 +102,20 @@ PRESETS: dict[str, TrainConfig] = {
         max_train_batches=24,
         max_val_triplets=160,
         num_workers=0,
+    ),
+    # One GPU (measured on an H100 with 16 cores): ResNet-18 at the datasets' 224 px, x_v from
+    # the 5th-stage map, the cpu preset's schedule; loader workers decode the PNGs in parallel
+    # so the GPU is not left waiting.
+    "gpu": TrainConfig(
+        depth=18,
+        roi_size=14,
+        visual_features="c5",
+        new_layers_lr_scale=10.0,
+        epochs=5,
+        batch_size=16,
+        decay_every=2,
+        max_val_triplets=320,
+        num_workers=12,
     ),
 }
 
