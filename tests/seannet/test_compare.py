@@ -4,10 +4,17 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 
-from seannet.compare import calibrate_batches, compare_models
+import pytest
+import torch
+
+from seannet.backbones import LITE0_WEIGHTS
+from seannet.compare import calibrate_batches, compare_models, model_spec
 from seannet.config import TrainConfig
+from seannet.errors import ModelError
+from seannet.train import build_for_dataset as compare_build
 
 TINY = TrainConfig(
     depth=18,
@@ -50,3 +57,46 @@ def test_budget_buys_batches(mini_dataset: Path) -> None:
     few = calibrate_batches(TINY.replace(model="resnet18", epochs=2), mini_dataset, 0.001)
     many = calibrate_batches(TINY.replace(model="resnet18", epochs=2), mini_dataset, 60.0)
     assert few == 1 and many > few
+
+
+def test_model_specs_name_network_and_imagenet_init() -> None:
+    config, weights = model_spec("seannet@lite0+imagenet", TINY)
+    assert (config.model, config.backbone, weights) == (
+        "seannet",
+        "efficientnet_lite0",
+        Path(LITE0_WEIGHTS),
+    )
+    config, weights = model_spec("seannet-graph@lite0", TINY)
+    assert (config.model, config.backbone, weights) == ("seannet-graph", "efficientnet_lite0", None)
+    config, weights = model_spec("efficientnet_lite0+imagenet", TINY)
+    assert (config.model, config.image_family, weights) == (
+        "efficientnet_lite0",
+        "efficientnet_lite0",
+        Path(LITE0_WEIGHTS),
+    )
+    assert model_spec("resnet18", TINY)[0].backbone == "resnet"
+
+
+@pytest.mark.parametrize(
+    "spec", ["resnet18+imagenet", "seannet+imagenet", "resnet18@lite0", "seannet@vgg"]
+)
+def test_model_specs_refused_before_any_run(tmp_path: Path, mini_dataset: Path, spec: str) -> None:
+    with pytest.raises(ModelError, match=re.escape(spec)):
+        compare_models(mini_dataset, tmp_path / "cmp", ["resnet18", spec], preset=TINY)
+    assert not (tmp_path / "cmp").exists()  # refused before the first (valid) model trained
+
+
+def test_compare_trains_from_imagenet_weights(tmp_path: Path, mini_dataset: Path) -> None:
+    out = tmp_path / "cmp"
+    small = TINY.replace(image_size=64)
+    result = compare_models(mini_dataset, out, ["efficientnet_lite0+imagenet"], preset=small)
+    assert result["models"][0]["pretrained"] == LITE0_WEIGHTS
+    # the run started from the ImageNet weights: its stem is not a fresh random init
+    state = torch.load(
+        out / "efficientnet_lite0+imagenet" / "lr0.01" / "seed0" / "best.pt", weights_only=False
+    )
+    stem = state["model"]["encoder.0.0.weight"]  # the stem convolution
+    torch.manual_seed(0)
+    fresh = compare_build(small.replace(model="efficientnet_lite0"), mini_dataset)
+    fresh_stem = fresh.state_dict()["encoder.0.0.weight"]
+    assert not torch.allclose(stem, fresh_stem, atol=1e-2)
