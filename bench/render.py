@@ -8,7 +8,11 @@ plain pyrender (one node per object, an RGB and a SEG pass) on the same views.
 
 Prints frames per second of the RGB pass, the id pass, both (what the pipeline must do) and
 the full pipeline (render -> annotate -> slots -> relations), and the pipeline's ratio to the
-bare passes (target >= 0.85).
+bare passes (target >= 0.85). Generated rooms are written textured (``[appearance]``
+defaults): ``rgb``, ``pipeline`` and the plain-pyrender rows draw them flat, as before
+textures existed; ``rgb_textured`` and ``pipeline_textured`` draw their textures, on the same
+views, flat and textured measured in turn twice (ABAB) so that a busy machine skews both
+alike; ``textured/flat`` is the pipeline's ratio (target >= 0.8: at most 20 % slower).
 """
 
 from __future__ import annotations
@@ -52,12 +56,15 @@ def generated_scenes(n: int, seed: int) -> list[tuple[Room, SceneGeometry]]:
 
     catalog = load_catalog()
     types = ["kitchen", "living_room", "bedroom", "bathroom"]
+    from sgdata.world.appearance import AppearanceConfig
+
     out = []
     tmp = Path(tempfile.mkdtemp(prefix="sgdata-bench-"))
     for k in range(n):
         room = generate_room(types[k % len(types)], k // len(types), seed, catalog)
-        path = tmp / f"{room.room_id}.usda"
-        usd_io.write_room(room, path, geometry=usd_io.catalog_geometry(catalog))
+        path = tmp / room.room_id / "room.usda"  # textures shared in tmp/textures
+        geometry = usd_io.catalog_geometry(catalog)
+        usd_io.write_room(room, path, geometry=geometry, appearance=AppearanceConfig())
         out.append((room, read_geometry(path)))
     return out
 
@@ -91,15 +98,16 @@ class NaivePyrender:
         self.gl = pr.OffscreenRenderer(camera.width, camera.height)
 
     def load(self, geometry: SceneGeometry) -> None:
-        from sgdata.render.renderer import _ceiling_light_pose, _primitive
+        from sgdata.render.primitives import primitive
+        from sgdata.render.renderer import _ceiling_light_pose
 
         pr, camera = self.pr, self.camera
         scene = pr.Scene(bg_color=[0.45, 0.45, 0.48, 1.0], ambient_light=[0.35] * 3)
         seg = {}
         for m in geometry.structure:
-            seg[scene.add(pr.Mesh([_primitive(pr, m, double_sided=True)]))] = np.zeros(3)
+            seg[scene.add(pr.Mesh([primitive(pr, m, double_sided=True)]))] = np.zeros(3)
         for k, obj in enumerate(geometry.objects, 1):
-            node = scene.add(pr.Mesh([_primitive(pr, obj.mesh)]), pose=np.asarray(obj.matrix))
+            node = scene.add(pr.Mesh([primitive(pr, obj.mesh)]), pose=np.asarray(obj.matrix))
             seg[node] = np.array([k & 255, (k >> 8) & 255, k >> 16])
         cam = pr.PerspectiveCamera(yfov=camera.yfov, aspectRatio=camera.width / camera.height)
         self.cam_node = scene.add(cam)
@@ -141,20 +149,32 @@ def main() -> None:
     naive = NaivePyrender(renderer.camera)
     annotator = ViewAnnotator(renderer, slots)
     rng = np.random.default_rng(args.seed)
-    keys = ("rgb", "ids", "rgb+ids", "pipeline", "naive")
+    keys = ("rgb", "ids", "rgb+ids", "pipeline", "naive", "rgb_textured", "pipeline_textured")
     totals: dict[str, list[float]] = {k: [] for k in keys}
+
+    def draw(textured: bool) -> None:
+        renderer.textures = textured
+        renderer.load(geometry)  # rebuilds the primitives with or without textures
+
     for room, geometry in scenes:
         annotator.set_layout(room, geometry, 0)
         poses = sample_poses(room, args.views, rng)
         if not poses:
             print(f"{room.room_id}: no reachable cells, skipped")
             continue
+        draw(False)
         fps = {
             "rgb": rate(lambda p: renderer.render_rgb(p.x, p.y, p.theta), poses),
             "ids": rate(lambda p: renderer.render_ids(p.x, p.y, p.theta), poses),
             "rgb+ids": rate(lambda p: renderer.render(p.x, p.y, p.theta), poses),
-            "pipeline": rate(lambda p: annotator.view(p), poses),
         }
+        runs: dict[str, list[float]] = {"pipeline": [], "pipeline_textured": []}
+        for textured in (False, True, False, True):  # ABAB: load changes hit both alike
+            draw(textured)
+            key = "pipeline_textured" if textured else "pipeline"
+            runs[key].append(rate(lambda p: annotator.view(p), poses))
+        fps["rgb_textured"] = rate(lambda p: renderer.render_rgb(p.x, p.y, p.theta), poses)
+        fps.update({k: float(np.mean(v)) for k, v in runs.items()})
         naive.load(geometry)
         fps["naive"] = rate(naive.view, poses)
         for key, value in fps.items():
@@ -169,6 +189,7 @@ def main() -> None:
         mean = {k: float(np.mean(v)) for k, v in totals.items()}
         mean["pipeline/naive"] = mean["pipeline"] / mean["naive"]
         mean["pipeline/(rgb+ids)"] = mean["pipeline"] / mean["rgb+ids"]
+        mean["textured/flat"] = mean["pipeline_textured"] / mean["pipeline"]
         if args.json:
             print(json.dumps(mean))
         else:

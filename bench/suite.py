@@ -13,8 +13,8 @@ Rows, each measured in a fresh process on this machine, one after the other:
 - loader: ``bench/loader.py`` on the ``tiny`` preset (its own table follows);
 - validate: ``sgdata validate`` on a dataset (``--validate``, default the tiny one).
 
-The ratios the project holds itself to: pipeline >= 1.3x plain pyrender; 2 workers >= 1.8x
-one; Ray local within 0.8x of the local pool.
+The ratios the project holds itself to: pipeline >= 1.3x plain pyrender; textured pipeline
+>= 0.8x the flat one; 2 workers >= 1.8x one; Ray local within 0.8x of the local pool.
 """
 
 from __future__ import annotations
@@ -53,6 +53,12 @@ def main() -> None:
         ("render, 1 thread", "pipeline (annotated views/s)", f"{render['pipeline']:.1f}"),
         ("render, 1 thread", "plain pyrender RGB + SEG (views/s)", f"{render['naive']:.1f}"),
         ("render, 1 thread", "pipeline / plain pyrender", f"{render['pipeline/naive']:.2f}x"),
+        (
+            "render, 1 thread",
+            "pipeline with textures (annotated views/s)",
+            f"{render['pipeline_textured']:.1f}",
+        ),
+        ("render, 1 thread", "pipeline textured / flat", f"{render['textured/flat']:.2f}x"),
     ]
 
     runs = {}

@@ -34,15 +34,26 @@ def rooms(
     catalog: Annotated[
         Path | None, typer.Option(help="An object catalog TOML (default: the shipped one).")
     ] = None,
+    textures: Annotated[
+        bool,
+        typer.Option(help="Procedural textures (shared in OUT/textures/); --no-textures: flat."),
+    ] = True,
 ) -> None:
     """Generate procedural rooms and write them as USD stages."""
     from sgdata.usd.scene_dirs import write_rooms
+    from sgdata.world.appearance import AppearanceConfig
     from sgdata.world.catalog import load_catalog
     from sgdata.world.rooms import room_stats
 
     classes = load_catalog(catalog)
     made = write_rooms(
-        out, room_type, count=count, seed=seed, first_index=first_index, catalog=classes
+        out,
+        room_type,
+        count=count,
+        seed=seed,
+        first_index=first_index,
+        catalog=classes,
+        appearance=AppearanceConfig(textures=textures),
     )
     table = Table(title=f"{len(made)} {room_type} room(s) in {out}")
     for column in ("room", "size (m)", "objects", "static", "low", "high", "classes"):
@@ -66,12 +77,19 @@ def layouts(
     room_dir: Annotated[Path, typer.Argument(help="A room directory holding room.usda.")],
     count: Annotated[int, typer.Option(help="Layouts to write, layout 0 being the base.")] = 5,
     seed: Annotated[int, typer.Option(help="Seed of the layouts (mixed with the room's).")] = 0,
+    appearance: Annotated[
+        bool,
+        typer.Option(help="Each layout draws its light and moving objects' looks ([appearance])."),
+    ] = True,
 ) -> None:
     """Sample layouts of a room under the dynamics rules and write them as USD layers."""
     from sgdata.usd.scene_dirs import write_layouts
+    from sgdata.world.appearance import AppearanceConfig
     from sgdata.world.dynamics import summarize_layouts
 
-    made = write_layouts(room_dir, count=count, seed=seed)
+    made = write_layouts(
+        room_dir, count=count, seed=seed, appearance=AppearanceConfig() if appearance else None
+    )
     table = Table(title=f"{len(made)} layout(s) of {room_dir}")
     for column in ("layout", "moved", "carried", "stayed put", "seed"):
         table.add_column(column, justify="right")
@@ -116,7 +134,9 @@ def tag(
     stage: Annotated[Path, typer.Argument(help="Your own USD room (never modified).")],
     classes: Annotated[
         Path | None,
-        typer.Option("--classes", help="TOML of non-catalog classes and their dynamics."),
+        typer.Option(
+            "--classes", help="TOML of non-catalog classes: a dynamics, or a catalog class."
+        ),
     ] = None,
     output: Annotated[
         Path | None,
@@ -218,6 +238,9 @@ def render(
     output: Annotated[Path, typer.Option("-o", "--output", help="PNG of the view.")] = Path(
         "view.png"
     ),
+    textures: Annotated[
+        bool, typer.Option(help="Draw the room's textures; --no-textures: flat colours.")
+    ] = True,
 ) -> None:
     """Render one annotated view; also writes <output>.overlay.png with boxes and relations."""
     from PIL import Image
@@ -234,7 +257,7 @@ def render(
         except ValueError:
             raise ConfigError(f"--pose {pose!r}: expected I,J,H such as 4,6,1") from None
         cell = (i, j)
-    record = render_snapshot(room_dir, layout=layout, cell=cell, heading=heading)
+    record = render_snapshot(room_dir, layout=layout, cell=cell, heading=heading, textures=textures)
     overlay_path = output.with_suffix(".overlay.png")
     save_png(Image.fromarray(record.rgb), output)
     save_png(draw_overlay(record), overlay_path)
@@ -253,12 +276,16 @@ def validate(
     ] = False,
     quick: Annotated[bool, typer.Option(help="Skip decoding the images.")] = False,
     usd: Annotated[bool, typer.Option(help="Also run USD's validators on the scenes.")] = False,
+    sources: Annotated[
+        Path | None,
+        typer.Option(help="Folder of the generating config: check its [rooms] files unchanged."),
+    ] = None,
     show: Annotated[int, typer.Option(help="Problems to list in the summary.")] = 20,
 ) -> None:
     """Check a dataset against its format; exit 0 only when every check passes."""
     from sgdata.validate import validate_dataset
 
-    report = validate_dataset(root, quick=quick, usd=usd)
+    report = validate_dataset(root, quick=quick, usd=usd, sources=sources)
     if json_out:
         print(report.to_json())
     else:

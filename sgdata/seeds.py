@@ -4,12 +4,16 @@ This module is the one home of every derivation path, so two stages can never dr
 same stream by accident and a path never changes without this file changing::
 
     dataset seed ─┬─ room_seed(type index, room index) ─┬─ layouts_seed(request) ─ layout_seed(k)
-                  │                                     └─ view_seed(layout, i, j, heading)
+                  │                                     ├─ view_seed(layout, i, j, heading)
+                  │                                     └─ room_look_seed()  (base looks)
+                  ├─ own_room_seed(room id)  (a user's room of [rooms] files; then as above)
                   └─ split_triplets_seed(split) ─ triplet_stream_seed(split, room, tier)
     training seed ─ init_seed() / epoch_order_seed(epoch) / epoch_dropout_seed(epoch)
     navigator seed ─ navigator_init_seed() / navigator_pairs_seed(split, room)
                    └ navigator_order_seed(epoch)
     navigation test seed ─ episode_seed(room, case, index)
+    layout seed ─ appearance_seed()  (the layout's light and looks of its moving objects)
+    texture_seed(kind, variant)  (procedural texture images: no dataset seed, shared by all)
 """
 
 from __future__ import annotations
@@ -23,6 +27,7 @@ __all__ = [
     "rng_for",
     "name_key",
     "room_seed",
+    "own_room_seed",
     "layouts_seed",
     "layout_seed",
     "view_seed",
@@ -35,12 +40,19 @@ __all__ = [
     "navigator_pairs_seed",
     "navigator_order_seed",
     "episode_seed",
+    "room_look_seed",
+    "appearance_seed",
+    "texture_seed",
 ]
 
 _TRIPLETS = "triplets"  # the purpose key of triplet streams
 _INIT = 1 << 20  # the initial weights (epochs use 0, 1, 2, ...)
 _NAVIGATOR = "navigator"  # the purpose key of the visual navigator's streams
 _EPISODES = "episodes"  # the purpose key of the navigation test's episodes
+_LOOKS = "looks"  # the purpose key of a room's base looks (texture variants)
+_APPEARANCE = "appearance"  # the purpose key of a layout's appearance draw
+_TEXTURES = "textures"  # the root key of procedural texture images
+_OWN_ROOMS = "own rooms"  # the purpose key of the rooms users bring ([rooms] files)
 
 
 def derive_seed(parent: int, *keys: int) -> int:
@@ -67,6 +79,12 @@ def name_key(name: str) -> int:
 def room_seed(dataset_seed: int, type_index: int, index: int) -> int:
     """A room's seed: its type's position in the room-type list and its number in the type."""
     return derive_seed(dataset_seed, type_index, index)
+
+
+def own_room_seed(dataset_seed: int, room_id: str) -> int:
+    """A user room's seed (its layouts and views derive from it), by its room id: adding or
+    reordering ``[rooms] files`` entries moves no other room's draws."""
+    return derive_seed(dataset_seed, name_key(_OWN_ROOMS), name_key(room_id))
 
 
 def layouts_seed(room: int, request: int) -> int:
@@ -128,3 +146,20 @@ def episode_seed(test_seed: int, room_id: str, case: str, index: int) -> int:
     """One navigation-test episode (its layout, start and goal), by names: every localizer
     run is tested on the same episodes."""
     return derive_seed(test_seed, name_key(_EPISODES), name_key(room_id), name_key(case), index)
+
+
+def room_look_seed(room: int) -> int:
+    """A room's base looks: the texture variant of its structure and of every object."""
+    return derive_seed(room, name_key(_LOOKS))
+
+
+def appearance_seed(layout: int) -> int:
+    """A layout's appearance (light intensity and colour temperature, looks of its low- and
+    high-dynamic objects), from the layout's own seed."""
+    return derive_seed(layout, name_key(_APPEARANCE))
+
+
+def texture_seed(kind: str, variant: int) -> int:
+    """One procedural texture image, by its kind and variant only: every room and dataset
+    shares the same images."""
+    return derive_seed(name_key(_TEXTURES), name_key(kind), variant)

@@ -13,6 +13,11 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+
+# Before any EGL context: Mesa's llvmpipe and triton (loaded by torch._dynamo, which
+# torchvision's models import) each bring an LLVM, and loading triton after Mesa segfaults.
+# `import seannet` does this first in its own processes; the test session mixes both.
+import torch._dynamo  # noqa: F401  isort: skip
 import trimesh
 
 from sgdata.usd.meshes import MeshData, ObjectGeometry, SceneGeometry

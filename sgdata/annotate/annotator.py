@@ -15,7 +15,7 @@ from sgdata.annotate.slots import SlotTable
 from sgdata.errors import RenderError
 from sgdata.render.camera import CameraConfig
 from sgdata.render.renderer import Renderer
-from sgdata.usd.meshes import SceneGeometry
+from sgdata.usd.meshes import Lighting, SceneGeometry
 from sgdata.world.scene import Room
 
 __all__ = ["ViewAnnotator"]
@@ -49,6 +49,8 @@ class ViewAnnotator:
         self._room: Room | None = None
         self._layout = -1
         self._table: ObjectTable | None = None
+        self._lighting = Lighting()
+        self._textured = False
 
     @property
     def camera(self) -> CameraConfig:
@@ -62,6 +64,9 @@ class ViewAnnotator:
             self.renderer.load(geometry)
         self._room, self._layout = room, int(layout)
         self._table = ObjectTable.from_scene(geometry, room)
+        self._lighting = geometry.lighting
+        meshes = (*geometry.structure, *(o.mesh for o in geometry.objects))
+        self._textured = self.renderer.textures and any(m.textured for m in meshes)
 
     def view(self, pose: ViewPose, *, seed: int = 0, jitter_lights: bool = False) -> ViewRecord:
         """Render and annotate one view of the current layout.
@@ -119,5 +124,8 @@ class ViewAnnotator:
             rel_dst=rel.dst,
             rel_type=rel.type,
             dropped_objects=assignment.dropped,
+            textures=self._textured,
+            light_intensity=self._lighting.intensity,
+            light_temperature=self._lighting.temperature,
             depth=rendered.depth if self.keep_depth else None,
         )

@@ -65,6 +65,9 @@ class ViewRecord:
     rel_dst: np.ndarray  # (E,) int64
     rel_type: np.ndarray  # (E,) int8
     dropped_objects: int = 0  # visible objects beyond their class's slot run
+    textures: bool | None = None  # whether surfaces were drawn textured (None: unknown)
+    light_intensity: float | None = None  # scale of the default lights (the stage's light)
+    light_temperature: float | None = None  # Kelvin; None: the default white light
     depth: np.ndarray | None = field(default=None, repr=False)  # (H, W) float32 if kept
 
     @property

@@ -6,6 +6,8 @@ All paths are relative to the dataset root and use ``/`` on every platform (they
     dataset.json                              the manifest
     scenes/<room_id>/room.usda                the base room
     scenes/<room_id>/layout_<k>.usda          layout k as a USD layer over the base
+    scenes/<room_id>/source.usda              a user's room ([rooms] files), flattened
+    scenes/textures/<kind>_<v>_<size>px.png   texture images the textured rooms share
     observations/<split>/<room_id>.parquet    one row per view of the room
     triplets/<split>.parquet                  one row per triplet of the split
 """
@@ -16,7 +18,7 @@ from pathlib import Path, PurePosixPath
 from typing import NamedTuple
 
 from sgdata.errors import DatasetError
-from sgdata.scene_files import LAYOUT_FILE, ROOM_FILE
+from sgdata.scene_files import LAYOUT_FILE, ROOM_FILE, TEXTURES_DIR
 
 __all__ = [
     "MANIFEST",
@@ -25,6 +27,7 @@ __all__ = [
     "SCENES",
     "SCENE_ROOM",
     "SCENE_LAYER",
+    "SCENE_TEXTURES",
     "SPLITS",
     "OUTPUTS",
     "ObsKey",
@@ -42,6 +45,7 @@ TRIPLETS = "triplets/{split}.parquet"
 SCENES = "scenes/{room_id}"
 SCENE_ROOM = SCENES + "/" + ROOM_FILE
 SCENE_LAYER = SCENES + "/" + LAYOUT_FILE.replace("{index}", "{layout}")
+SCENE_TEXTURES = SCENES.split("/")[0] + "/" + TEXTURES_DIR  # beside the room directories
 SPLITS = ("train", "val", "test")  # the split names a dataset may hold, in this order
 # What a generation writes at the top of a dataset directory (``--force`` removes exactly these).
 OUTPUTS = (MANIFEST, *(t.split("/")[0] for t in (SCENES, OBSERVATIONS, TRIPLETS)))

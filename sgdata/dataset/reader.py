@@ -18,7 +18,7 @@ from PIL import Image
 from sgdata.dataset.manifest import Manifest, read_manifest
 from sgdata.dataset.paths import MANIFEST, observations_path, triplets_path
 from sgdata.dataset.rows import sha256_file
-from sgdata.dataset.schema import FORMAT_VERSION, observations_schema, triplets_schema
+from sgdata.dataset.schema import FORMAT_VERSION, observations_schema, since, triplets_schema
 from sgdata.errors import DatasetError
 
 __all__ = ["Dataset", "decode_image", "read_table"]
@@ -46,7 +46,8 @@ def read_table(
 
     The one reader of observation and triplet files: :class:`Dataset`, ``sgdata validate`` and
     the training loader all come through here. Columns the file has beyond the schema (a newer
-    minor format) are not read.
+    minor format) are not read; columns a later minor added (``since`` in the schema) that an
+    older file lacks come back as nulls.
 
     Args:
         cast: cast columns whose type differs but converts (``validate`` reports the type
@@ -66,12 +67,26 @@ def read_table(
     expected = pa.schema([schema.field(n) for n in names])
     try:
         found = pq.read_schema(path)
-        missing = [n for n in names if n not in found.names]
+        absent = [n for n in names if n not in found.names]
+        added = {n for n in absent if since(schema.field(n))}
+        missing = [n for n in absent if n not in added]
         if missing:
             raise DatasetError(
                 f"{path}: no column(s) {missing}; not a format {FORMAT_VERSION} {name} table"
             )
-        table = pq.read_table(path, columns=names)
+        table = pq.read_table(path, columns=[n for n in names if n not in added])
+        if added:  # an older minor's file: the columns added since are null
+            table = pa.Table.from_arrays(
+                [
+                    pa.nulls(table.num_rows, expected.field(n).type)
+                    if n in added
+                    else table.column(n)
+                    for n in names
+                ],
+                schema=pa.schema(
+                    [expected.field(n) if n in added else table.schema.field(n) for n in names]
+                ),
+            )
         if cast and not table.schema.equals(expected):
             table = table.cast(expected)
     except (pa.ArrowException, OSError, ValueError) as exc:

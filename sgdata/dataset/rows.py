@@ -240,6 +240,9 @@ def observation_table(
         "dropped_objects": pa.array([r.dropped_objects for r in records], type=pa.int16()),
         "scene": pa.array(scenes, type=pa.string()),
         "seed": pa.array([r.seed for r in records], type=pa.int64()),
+        "textures": pa.array([r.textures for r in records], type=pa.bool_()),
+        "light_intensity": pa.array([r.light_intensity for r in records], type=pa.float32()),
+        "light_temperature": pa.array([r.light_temperature for r in records], type=pa.float32()),
     }
     return pa.Table.from_arrays([columns[f.name] for f in schema], schema=schema)
 

@@ -11,11 +11,13 @@ so the JSON files in ``schemas/`` (installed as the ``sgdata_schemas`` package)
 are the single source of truth.
 
 The DSL: a table is ``{"name", "format_version", "doc", "fields": [field, ...]}``; a field is
-``{"name", "type", "nullable", "doc"}``; a type is one of ``string binary bool int8 int16
-int32 int64 float32 float64``, ``{"list": T}``, ``{"fixed_list": [T, n]}`` or ``{"struct":
-[field, ...]}``. Field docs become Arrow field metadata under ``b"doc"``. List elements are
-non-null and named ``element`` (the Parquet-compliant name, so a schema read back from a file
-compares equal to the one written).
+``{"name", "type", "nullable", "doc"}``, plus ``"since": "<version>"`` on a nullable column a
+minor version added (Arrow metadata ``b"since"``: readers fill it with nulls in files of an
+older minor, and :func:`schema_at` drops it from what such a file must hold); a type is one
+of ``string binary bool int8 int16 int32 int64 float32 float64``, ``{"list": T}``,
+``{"fixed_list": [T, n]}`` or ``{"struct": [field, ...]}``. Field docs become Arrow field
+metadata under ``b"doc"``. List elements are non-null and named ``element`` (the
+Parquet-compliant name, so a schema read back from a file compares equal to the one written).
 """
 
 from __future__ import annotations
@@ -44,15 +46,19 @@ __all__ = [
     "manifest_json_schema",
     "table_schema",
     "parse_table_schema",
+    "schema_at",
     "schema_markdown",
+    "since",
 ]
 
-FORMAT_VERSION = "1.0.0"  # semver of the whole on-disk format: tables + dataset.json
+FORMAT_VERSION = "1.1.0"  # semver of the whole on-disk format: tables + dataset.json
+# 1.1.0 added the observation columns textures, light_intensity and light_temperature.
 SCHEMA_PACKAGE = "sgdata_schemas"  # the installed name of the repository's `schemas/` folder
 LIST_ELEMENT = "element"  # Parquet's compliant list element name (pyarrow writes it by default)
 UPGRADE_HINT = "upgrade sgdata: pip install -U sgdata"
 # from-version -> function taking the raw manifest dict of that version and returning the dict
-# of the next version (with its format_version set). Empty: 1.0.0 is the first format.
+# of the next version (with its format_version set). Empty: 1.1.0 only added nullable columns
+# (marked "since"), and 1.0.0 manifests need no change.
 MIGRATIONS: dict[str, Callable[[dict[str, Any]], dict[str, Any]]] = {}
 _SEMVER = re.compile(r"^(0|[1-9]\d*)\.(0|[1-9]\d*)\.(0|[1-9]\d*)(?:[-+][0-9A-Za-z.+-]+)?$")
 log = logging.getLogger(__name__)
@@ -69,6 +75,7 @@ _PRIMITIVES: dict[str, pa.DataType] = {
     "float64": pa.float64(),
 }
 _FIELD_KEYS = {"name", "type", "nullable", "doc"}
+_OPTIONAL_KEYS = {"since"}
 
 
 def _read_json(filename: str) -> dict[str, Any]:
@@ -109,19 +116,43 @@ def _parse_type(spec: Any, where: str) -> pa.DataType:
 
 
 def _parse_field(spec: Any, parent: str) -> pa.Field:
-    if not isinstance(spec, dict) or set(spec) != _FIELD_KEYS:
+    if not isinstance(spec, dict) or not _FIELD_KEYS <= set(spec) <= _FIELD_KEYS | _OPTIONAL_KEYS:
         raise DatasetError(
-            f"{parent}: field {spec!r}; expected exactly the keys {sorted(_FIELD_KEYS)}"
+            f"{parent}: field {spec!r}; expected exactly the keys {sorted(_FIELD_KEYS)} "
+            f"(and optionally {sorted(_OPTIONAL_KEYS)})"
         )
     where = f"{parent}.{spec['name']}"
     if not isinstance(spec["nullable"], bool):
         raise DatasetError(f"{where}: nullable {spec['nullable']!r}; expected true or false")
+    metadata = {b"doc": str(spec["doc"]).encode("utf-8")}
+    if "since" in spec:
+        added = spec["since"]
+        if not spec["nullable"] or _parse_version(added) > _parse_version(FORMAT_VERSION):
+            raise DatasetError(
+                f"{where}: since {added!r}; only a nullable column may be added, in a version "
+                f"up to {FORMAT_VERSION}"
+            )
+        metadata[b"since"] = str(added).encode("utf-8")
     return pa.field(
-        spec["name"],
-        _parse_type(spec["type"], where),
-        nullable=spec["nullable"],
-        metadata={b"doc": str(spec["doc"]).encode("utf-8")},
+        spec["name"], _parse_type(spec["type"], where), nullable=spec["nullable"], metadata=metadata
     )
+
+
+def since(field: pa.Field) -> str | None:
+    """The format version that added column ``field``, or None for one as old as the major."""
+    value = (field.metadata or {}).get(b"since")
+    return value.decode() if value else None
+
+
+def schema_at(schema: pa.Schema, version: str) -> pa.Schema:
+    """``schema`` as a file of format ``version`` holds it: without the columns added later.
+
+    Raises:
+        FormatVersionError: ``version`` is not a semantic version.
+    """
+    at = _parse_version(version)
+    keep = [f for f in schema if since(f) is None or _parse_version(since(f)) <= at]
+    return pa.schema(keep, metadata=schema.metadata)
 
 
 def parse_table_schema(spec: dict[str, Any]) -> pa.Schema:
@@ -280,6 +311,8 @@ def _rows(fields: list[pa.Field], prefix: str) -> list[str]:
     lines = []
     for f in fields:
         doc = (f.metadata or {}).get(b"doc", b"").decode()
+        if since(f):
+            doc = f"{doc} (since format {since(f)})"
         doc = doc.replace("|", "\\|").replace("<", "\\<")  # Markdown table cell
         null = "yes" if f.nullable else "no"
         lines.append(f"| `{prefix}{f.name}` | `{_type_text(f.type)}` | {null} | {doc} |")

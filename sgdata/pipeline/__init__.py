@@ -6,10 +6,13 @@ _EXPORTS = {
     "AnnotationConfig": ".config",
     "DatasetConfig": ".config",
     "GenerateConfig": ".config",
+    "INTERNAL": ".config",
     "ImagesConfig": ".config",
     "LayoutsConfig": ".config",
     "PRESETS": ".config",
     "PosesConfig": ".config",
+    "ROOM_TYPE_NAME": ".config",
+    "RoomFile": ".config",
     "RoomsConfig": ".config",
     "TripletsConfig": ".config",
     "config_to_dict": ".config",
@@ -32,6 +35,8 @@ _EXPORTS = {
     "render_room_views": ".room_tasks",
     "write_room_scenes": ".room_tasks",
     "render_snapshot": ".snapshot",
+    "resolve_user_rooms": ".user_rooms",
+    "copy_user_room": ".user_rooms",
 }
 
 __all__ = sorted(_EXPORTS)

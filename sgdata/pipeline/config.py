@@ -2,25 +2,31 @@
 
 Each TOML table is one dataclass: ``[dataset]`` -> :class:`DatasetConfig`, ``[rooms]`` ->
 :class:`RoomsConfig`, ``[dynamics]`` -> :class:`sgdata.world.dynamics.DynamicsConfig`, ``[camera]``
--> :class:`sgdata.render.camera.CameraConfig`, and so on. Unknown keys and wrong types are refused
-with the file and key path in the message; every dataclass validates its own values.
+-> :class:`sgdata.render.camera.CameraConfig`, ``[appearance]`` ->
+:class:`sgdata.world.appearance.AppearanceConfig`, and so on. Unknown keys and wrong types are
+refused with the file and key path in the message; every dataclass validates its own values.
+
+Fields marked :data:`INTERNAL` are set by the loader, never read from TOML nor written to the
+manifest (``RoomsConfig.base_dir``: the folder ``[rooms] files`` are relative to).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import re
 import tomllib
 import types
 import typing
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 from sgdata.annotate.relations import RelationRules
 from sgdata.dataset.paths import SPLITS
 from sgdata.errors import ConfigError, SgdataError
 from sgdata.render.camera import CameraConfig
+from sgdata.world.appearance import AppearanceConfig
 from sgdata.world.dynamics import DynamicsConfig
 from sgdata.world.poses import PosesConfig
 from sgdata.world.room_recipes import ROOM_TYPES
@@ -34,6 +40,9 @@ __all__ = [
     "ImagesConfig",
     "LayoutsConfig",
     "PosesConfig",
+    "INTERNAL",
+    "ROOM_TYPE_NAME",
+    "RoomFile",
     "RoomsConfig",
     "TripletsConfig",
     "config_to_dict",
@@ -41,6 +50,9 @@ __all__ = [
 ]
 
 PRESETS = ("tiny", "small", "medium", "paper")
+INTERNAL = {"internal": True}  # field metadata: set by load_config, not a TOML key
+_ROOM_ID = re.compile(r"[A-Za-z0-9][A-Za-z0-9_-]*")
+ROOM_TYPE_NAME = re.compile(r"[a-z][a-z0-9_]*")  # what a user room's type may be
 
 
 @dataclass(frozen=True)
@@ -61,29 +73,91 @@ class DatasetConfig:
 
 
 @dataclass(frozen=True)
-class RoomsConfig:
-    """Which rooms, and how many of each type go to each split (paper: 21 / 4 / 5)."""
+class RoomFile:
+    """A room the user brings (one ``[rooms] files`` entry): a USD file, tagged or not.
 
-    types: tuple[str, ...] = ROOM_TYPES
-    train: int = 21
-    val: int = 4
-    test: int = 5
+    In TOML a bare string is the path: ``files = ["a.usda", { path = "b.usda", split = "test" }]``.
+    """
+
+    SHORTHAND: ClassVar[str] = "path"  # a bare string in TOML sets this field
+
+    path: str  # the USD file, relative to the config file's folder (or absolute); only read
+    split: str = "train"  # train | val | test
+    id: str = ""  # room id; default: the file's stem, characters other than A-Z a-z 0-9 _ - as _
+    type: str = ""  # room_type of its rows; default: the file's sgdata:roomType, else "custom"
+    sha256: str = ""  # the file's SHA-256, filled in by generation; pin it to refuse a change
 
     def __post_init__(self) -> None:
-        unknown = [t for t in self.types if t not in ROOM_TYPES]
-        if unknown or not self.types:
+        where = f"rooms.files entry {self.path!r}"
+        if not self.path:
+            raise ConfigError("rooms.files: an entry with an empty path; expected a USD file")
+        if self.split not in SPLITS:
+            raise ConfigError(f"{where}: split {self.split!r}; expected one of {list(SPLITS)}")
+        if not self.id:
+            stem = re.sub(r"[^A-Za-z0-9_-]+", "_", Path(self.path).stem).strip("_-")
+            object.__setattr__(self, "id", stem or "room")
+        if not _ROOM_ID.fullmatch(self.id):
             raise ConfigError(
-                f"rooms.types {list(self.types)}: expected some of {list(ROOM_TYPES)}"
+                f"{where}: id {self.id!r}; expected letters, digits, '_' and '-' "
+                "(starting with a letter or digit)"
+            )
+        if self.type and not ROOM_TYPE_NAME.fullmatch(self.type):
+            raise ConfigError(
+                f"{where}: type {self.type!r}; expected lower-case letters, digits and '_'"
+            )
+        if self.sha256 and not re.fullmatch(r"[0-9a-f]{64}", self.sha256):
+            raise ConfigError(f"{where}: sha256 {self.sha256!r}; expected 64 lower-case hex digits")
+
+
+@dataclass(frozen=True)
+class RoomsConfig:
+    """Which rooms: procedural ones (per type, how many to each split; paper: 21 / 4 / 5) and
+    the user's own USD rooms (``files``), which go to the split their entry names."""
+
+    types: tuple[str, ...] | None = None  # None: all four types, or none when files are listed
+    train: int = 21  # procedural rooms per type
+    val: int = 4
+    test: int = 5
+    files: tuple[RoomFile, ...] = ()  # user rooms, in this order after the procedural ones
+    classes: str = ""  # class file for the files' classes (aliases of catalog classes)
+    base_dir: str = field(default="", metadata=INTERNAL)  # files' folder ("": working dir)
+
+    def __post_init__(self) -> None:
+        if self.types is None:
+            object.__setattr__(self, "types", () if self.files else ROOM_TYPES)
+        types = self.procedural_types
+        unknown = [t for t in types if t not in ROOM_TYPES]
+        if unknown or not (types or self.files):
+            raise ConfigError(
+                f"rooms.types {list(types)}: expected some of {list(ROOM_TYPES)} "
+                "(or user rooms in rooms.files)"
             )
         for split in SPLITS:
             if getattr(self, split) < 0:
                 raise ConfigError(f"rooms.{split} must be >= 0")
-        if self.train + self.val + self.test < 1:
+        if not self.files and self.train + self.val + self.test < 1:
             raise ConfigError("rooms: train + val + test must be at least 1")
+        seen: dict[str, str] = {}
+        for entry in self.files:
+            if entry.id in seen:
+                raise ConfigError(
+                    f"rooms.files: {entry.path!r} and {seen[entry.id]!r} both get room id "
+                    f'{entry.id!r}; give one another: {{ path = {entry.path!r}, id = "..." }}'
+                )
+            seen[entry.id] = entry.path
+
+    @property
+    def procedural_types(self) -> tuple[str, ...]:
+        """The room types of the procedural rooms (resolved: never ``None``)."""
+        return self.types or ()
 
     def per_split(self) -> dict[str, int]:
-        """Rooms per type in each split."""
+        """Procedural rooms per type in each split."""
         return {s: getattr(self, s) for s in SPLITS}
+
+    def resolve(self, path: str) -> Path:
+        """A path of this section (a file entry, ``classes``) against ``base_dir``."""
+        return Path(self.base_dir or ".") / Path(path).expanduser()
 
 
 @dataclass(frozen=True)
@@ -162,6 +236,7 @@ class GenerateConfig:
     annotation: AnnotationConfig = field(default_factory=AnnotationConfig)
     triplets: TripletsConfig = field(default_factory=TripletsConfig)
     images: ImagesConfig = field(default_factory=ImagesConfig)
+    appearance: AppearanceConfig = field(default_factory=AppearanceConfig)  # [appearance]
 
 
 def load_config(source: str | Path) -> GenerateConfig:
@@ -177,15 +252,19 @@ def load_config(source: str | Path) -> GenerateConfig:
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{where}: not valid TOML ({exc})") from None
     try:
-        return _build(GenerateConfig, data, "")
+        config = _build(GenerateConfig, data, "")
     except ConfigError as exc:
         raise ConfigError(f"{where}: {exc}") from None
+    if isinstance(source, str) and source in PRESETS:
+        return config
+    folder = str(Path(source).resolve().parent)
+    return dataclasses.replace(config, rooms=dataclasses.replace(config.rooms, base_dir=folder))
 
 
 def config_to_dict(config: Any) -> Any:
     """Plain JSON-able form of a config (tuples become lists), for the manifest."""
     if dataclasses.is_dataclass(config):
-        return {f.name: config_to_dict(getattr(config, f.name)) for f in dataclasses.fields(config)}
+        return {f.name: config_to_dict(getattr(config, f.name)) for f in _public_fields(config)}
     if isinstance(config, dict):
         return {str(k): config_to_dict(v) for k, v in config.items()}
     if isinstance(config, tuple | list):
@@ -210,7 +289,7 @@ def _build(cls: type, data: Any, prefix: str) -> Any:
     if not isinstance(data, dict):
         raise ConfigError(f"{prefix or 'config'}: expected a table")
     hints = typing.get_type_hints(cls)
-    names = {f.name for f in dataclasses.fields(cls)}
+    names = {f.name for f in _public_fields(cls)}
     unknown = sorted(set(data) - names)
     if unknown:
         key = f"{prefix}{unknown[0]}"
@@ -224,8 +303,16 @@ def _build(cls: type, data: Any, prefix: str) -> Any:
         raise ConfigError(f"{prefix.rstrip('.') or 'config'}: {exc}") from None
 
 
+def _public_fields(cls: Any) -> list[dataclasses.Field]:
+    """The fields a TOML table and the manifest have (not the :data:`INTERNAL` ones)."""
+    return [f for f in dataclasses.fields(cls) if not f.metadata.get("internal")]
+
+
 def _convert(hint: Any, value: Any, key: str) -> Any:
     if dataclasses.is_dataclass(hint):
+        shorthand = getattr(hint, "SHORTHAND", None)
+        if shorthand is not None and isinstance(value, str):
+            value = {shorthand: value}
         return _build(hint, value, f"{key}.")
     origin = typing.get_origin(hint)
     args = typing.get_args(hint)

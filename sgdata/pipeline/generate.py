@@ -22,7 +22,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from sgdata.dataset.paths import MANIFEST, OUTPUTS, SPLITS, scene_dir
+from sgdata.dataset.paths import MANIFEST, OUTPUTS, SCENE_TEXTURES, SPLITS, scene_dir
 from sgdata.errors import ConfigError
 from sgdata.fileio import atomic_write_text, prepare_output_dir, remove_stale_temps
 from sgdata.pipeline.config import GenerateConfig, config_to_dict
@@ -54,16 +54,19 @@ class GenerateProgress:
 
 
 def plan_rooms(config: GenerateConfig) -> list[RoomTask]:
-    """Rooms of every type, numbered per type: train first, then val, then test."""
+    """Procedural rooms of every type, numbered per type: train first, then val, then test;
+    then the user's rooms in ``[rooms] files`` order, each to the split its entry names."""
     tasks = []
     for room_type in ROOM_TYPES:
-        if room_type not in config.rooms.types:
+        if room_type not in config.rooms.procedural_types:
             continue
         index = 0
         for split, count in config.rooms.per_split().items():
             for _ in range(count):
                 tasks.append(RoomTask(room_type, index, split))
                 index += 1
+    for k, entry in enumerate(config.rooms.files):
+        tasks.append(RoomTask(entry.type, k, entry.split, name=entry.id))
     return tasks
 
 
@@ -83,14 +86,25 @@ def generate_dataset(
     ``executor`` is ``local`` (spawned processes) or ``ray`` (``address`` joins a cluster,
     without it a local instance); the bytes written are the same whatever runs them.
 
+    The rooms of ``[rooms] files`` are checked and hashed first
+    (:func:`sgdata.pipeline.user_rooms.resolve_user_rooms`): the manifest's config records each
+    file's sha256 and room type.
+
     Raises:
         ConfigError: ``root`` is a file, holds a finished dataset (without ``force``), holds
             an unfinished run (without ``resume`` or ``force``), or was started with another
-            config (on ``resume``).
+            config (on ``resume``); a ``[rooms] files`` entry or the class file is missing.
+        UsdError: a user room has no ``sgdata:class`` prim, a class the catalog lacks (and
+            the class file maps onto none), or cannot be read.
         DatasetError: a file cannot be written (the run can be resumed once fixed).
     """
     if workers < 1:
         raise ConfigError(f"--workers must be >= 1, got {workers}")
+    if config.rooms.files:  # checked and hashed before anything is written
+        from sgdata.pipeline.user_rooms import resolve_user_rooms
+
+        procedural = {t.room_id for t in plan_rooms(config) if not t.name}
+        config = resolve_user_rooms(config, taken=procedural)
     _prepare_root(root, config, resume=resume, force=force)
     with executor_session(executor, workers=workers, address=address):
         engine = {"workers": workers, "executor": executor, "address": address}
@@ -155,6 +169,8 @@ def _finish(
     for task in tasks:
         for usd in sorted(scene_dir(root, task.room_id).glob("*.usda")):
             files.append(file_entry(root, usd.relative_to(root).as_posix(), rows=None))
+    for image in sorted((root / SCENE_TEXTURES).glob("*.png")):  # shared by textured rooms
+        files.append(file_entry(root, image.relative_to(root).as_posix(), rows=None))
     slots, classes = class_vocabulary()
     manifest = Manifest(
         name=config.dataset.name,
@@ -200,14 +216,27 @@ def _prepare_root(root: Path, config: GenerateConfig, *, resume: bool, force: bo
     record = ledger / CONFIG_RECORD
     wanted = json.dumps(config_to_dict(config), sort_keys=True, indent=2)
     if record.exists():
-        if record.read_text(encoding="utf-8") != wanted:
+        started = record.read_text(encoding="utf-8")
+        if started != wanted:
             raise ConfigError(
-                f"{root}: was started with another config; rerun with that config "
-                "or pass --force to start over"
+                f"{root}: was started with another config{_changed_files(started, config)}; "
+                "rerun with that config or pass --force to start over"
             )
     else:
         ledger.mkdir(parents=True, exist_ok=True)
         atomic_write_text(record, wanted)
+
+
+def _changed_files(started: str, config: GenerateConfig) -> str:
+    """`` (rooms.files[k] 'a.usda' changed since)`` when a user room's file is what differs."""
+    try:
+        before = {f["id"]: f["sha256"] for f in json.loads(started)["rooms"]["files"]}
+    except (ValueError, KeyError, TypeError):
+        return ""
+    for k, entry in enumerate(config.rooms.files):
+        if entry.id in before and before[entry.id] != entry.sha256:
+            return f" (rooms.files[{k}] {entry.path!r} changed since: sha256 {entry.sha256})"
+    return ""
 
 
 def _remove_outputs(root: Path) -> None:
@@ -266,6 +295,11 @@ def _split_triplets(
     if total == 0:
         return []
     if not rooms:
-        raise ConfigError(f"triplets.{split} = {total} but rooms.{split} = 0: no room to draw from")
+        raise ConfigError(
+            f"triplets.{split} = {total} but no room is in split {split} (rooms.{split} = "
+            f"{config.rooms.per_split()[split]} per type for {len(config.rooms.procedural_types)} "
+            f'type(s), no rooms.files entry with split = "{split}"): set triplets.{split} = 0 '
+            "or add rooms"
+        )
     seed = split_triplets_seed(config.dataset.seed, SPLITS.index(split))
     return sample_triplets(rooms, total, seed, shares=config.triplets.shares)

@@ -34,24 +34,37 @@ class RoomTask:
     """One room of the dataset: the unit of parallel work."""
 
     room_type: str
-    index: int
+    index: int  # procedural: the room's number in its type; user room: its rooms.files entry
     split: str
+    name: str = ""  # a user room's id (its rooms.files entry's); empty for procedural rooms
 
     @property
     def room_id(self) -> str:
-        return f"{self.room_type}_{self.index:03d}"
+        return self.name or f"{self.room_type}_{self.index:03d}"
 
 
 def write_room_scenes(task: RoomTask, config: GenerateConfig, root: Path) -> dict:
     """Phase 1 of a room: USD room and layouts, and the reachable cells of every layout."""
+    from sgdata.pipeline.user_rooms import copy_user_room
     from sgdata.usd.room_io import catalog_geometry, read_room, write_room
     from sgdata.usd.scene_dirs import write_layouts
     from sgdata.world.rooms import generate_room
 
     catalog = load_catalog()
-    room = generate_room(task.room_type, task.index, config.dataset.seed, catalog)
     room_dir = scene_dir(root, task.room_id)
-    _guarded(lambda: write_room(room, room_file(room_dir), geometry=catalog_geometry(catalog)))
+    if task.name:  # a user's room: its stage copied in, tagged
+        entry = config.rooms.files[task.index]
+        room = _guarded(lambda: copy_user_room(entry, config, room_dir))
+    else:
+        room = generate_room(task.room_type, task.index, config.dataset.seed, catalog)
+        _guarded(
+            lambda: write_room(
+                room,
+                room_file(room_dir),
+                geometry=catalog_geometry(catalog),
+                appearance=config.appearance,
+            )
+        )
     layouts = _guarded(
         lambda: write_layouts(
             room_dir,
@@ -60,6 +73,7 @@ def write_room_scenes(task: RoomTask, config: GenerateConfig, root: Path) -> dic
             catalog=catalog,
             config=config.dynamics,
             poses=config.poses,
+            appearance=config.appearance,
         )
     )
     reachable = {}
@@ -126,7 +140,10 @@ def render_room_views(
 
 def _annotator(config: GenerateConfig) -> tuple[Any, dict[str, int]]:
     """This worker's view annotator, built once (its renderer stays alive)."""
-    key = json.dumps([config.camera.__dict__, config.annotation.min_visible_pixels], sort_keys=True)
+    key = json.dumps(
+        [config.camera.__dict__, config.annotation.min_visible_pixels, config.appearance.textures],
+        sort_keys=True,
+    )
     if _worker.get("key") != key:
         from sgdata.annotate.annotator import ViewAnnotator
         from sgdata.dataset.vocabulary import class_vocabulary
@@ -135,7 +152,7 @@ def _annotator(config: GenerateConfig) -> tuple[Any, dict[str, int]]:
         if "renderer" in _worker:
             _worker["renderer"].close()
         slots, classes = class_vocabulary()
-        renderer = Renderer(config.camera)
+        renderer = Renderer(config.camera, textures=config.appearance.textures)
         _worker.update(
             key=key,
             renderer=renderer,

@@ -30,10 +30,12 @@ def render_snapshot(
     robot_radius: float = 0.2,
     min_visible_pixels: int = 20,
     catalog: Catalog | None = None,
+    textures: bool = True,
 ) -> ViewRecord:
     """Render and annotate the view at grid ``cell`` and ``heading`` (0..3) of a layout.
 
-    ``cell=None`` takes the middle one of the layout's reachable cells (in index order).
+    ``cell=None`` takes the middle one of the layout's reachable cells (in index order);
+    ``textures=False`` draws a textured room in its flat colours.
 
     Raises:
         ConfigError: unknown room directory or layout, heading out of range, or a cell off the
@@ -59,7 +61,7 @@ def render_snapshot(
             f"reachable cells nearby: {' '.join(f'{a},{b}' for a, b in nearest)}"
         )
     x, y, theta = grid.pose_world(i, j, heading)
-    with Renderer(camera) as renderer:
+    with Renderer(camera, textures=textures) as renderer:
         annotator = ViewAnnotator(
             renderer,
             SlotTable.from_catalog(catalog),

@@ -4,6 +4,12 @@ from sgdata.lazy_face import lazy_face
 
 _EXPORTS = {
     "CameraConfig": ".camera",
+    "merged_world": ".primitives",
+    "primitive": ".primitives",
+    "same_mesh": ".primitives",
+    "same_shape": ".primitives",
+    "subset": ".primitives",
+    "untextured": ".primitives",
     "RenderedView": ".renderer",
     "Renderer": ".renderer",
     "use_egl_platform": ".renderer",

@@ -33,6 +33,13 @@ variable ``EGL_DEVICE_ID`` (an index into ``eglQueryDevicesEXT``, default 0; see
 CPU-only machine Mesa's llvmpipe is used; it spreads one render over all cores unless
 ``LP_NUM_THREADS`` is set (DESIGN §9: two workers with ``LP_NUM_THREADS=1`` beat one default).
 An EGL context does not survive ``fork``: build renderers inside each worker (spawn).
+
+Textures: faces a stage dresses in a texture (:attr:`MeshData.face_texture`) are drawn as the
+texture image (sRGB, repeat wrapping, trilinear mipmaps) times their face colour; the merged
+mesh becomes one primitive per texture file (plus one for untextured faces), in file order, so
+the draw order stays fixed. Each image is decoded and uploaded once per renderer.
+``textures=False`` draws the same faces in their flat colours. A stage's
+:class:`~sgdata.usd.meshes.Lighting` scales the lights and colours them (ambient included).
 """
 
 from __future__ import annotations
@@ -48,7 +55,15 @@ import numpy as np
 
 from sgdata.errors import RenderError
 from sgdata.render.camera import CameraConfig
-from sgdata.usd.meshes import MeshData, ObjectGeometry, SceneGeometry, merge_meshes
+from sgdata.render.primitives import (
+    merged_world,
+    primitive,
+    same_mesh,
+    same_shape,
+    subset,
+    untextured,
+)
+from sgdata.usd.meshes import Lighting, MeshData, SceneGeometry
 
 __all__ = ["RenderedView", "Renderer", "use_egl_platform"]
 
@@ -89,6 +104,7 @@ class Renderer:
         ambient: ambient light level (linear, 0..1).
         key_intensity: intensity of the head light that travels with the camera.
         fill_intensity: intensity of the point light under the ceiling's centre.
+        textures: draw the textures a stage binds (False: flat face colours only).
 
     Raises:
         RenderError: EGL cannot start (names the packages to install).
@@ -104,6 +120,7 @@ class Renderer:
         ambient: float = 0.35,
         key_intensity: float = 2.2,
         fill_intensity: float = 5.0,
+        textures: bool = True,
     ) -> None:
         if id_pass not in ("raycast", "raster"):
             raise RenderError(f"id_pass={id_pass!r}: expected 'raycast' or 'raster'")
@@ -112,6 +129,9 @@ class Renderer:
         self.ambient = float(ambient)
         self.key_intensity = float(key_intensity)
         self.fill_intensity = float(fill_intensity)
+        self.textures = bool(textures)
+        self._lighting = Lighting()
+        self._texture_cache: dict[str, Any] = {}  # file -> pyrender.Texture, decoded once
         use_egl_platform()
         try:
             import pyrender  # late: needs PYOPENGL_PLATFORM, and must not load at sgdata import
@@ -163,8 +183,8 @@ class Renderer:
         sc = pr.Scene(bg_color=[0.45, 0.45, 0.48, 1.0], ambient_light=[self.ambient] * 3)
         self._scene, self._rank = sc, {}
         for m in scene.structure:
-            self._add(pr.Mesh([_primitive(pr, m, double_sided=True)]))
-        self._merged_node = self._add(pr.Mesh([_primitive(pr, _merged_world(scene.objects))]))
+            self._add(pr.Mesh(self._primitives(m, double_sided=True)))
+        self._merged_node = self._add(pr.Mesh(self._primitives(merged_world(scene.objects))))
         self._cam_node = sc.add(self._camera_model())
         # Key light rides with the camera (faces towards the viewer always read), fill light
         # hangs under the ceiling's centre so tops and fronts of boxes differ in shade. One
@@ -175,6 +195,7 @@ class Renderer:
         self._key_node = sc.add(self._key)
         self._fill = pr.PointLight(color=np.ones(3), intensity=self.fill_intensity)
         sc.add(self._fill, pose=_ceiling_light_pose(scene))
+        self._set_lighting(scene.lighting)
         # One node per object for the SEG pass, hidden during the RGB pass. Both live in the
         # one scene: pyrender unloads the GPU buffers of meshes absent from the scene it draws,
         # so alternating two scenes would re-upload everything every view.
@@ -182,7 +203,7 @@ class Renderer:
         self._seg_map = {node: zero for node in sc.mesh_nodes if node is not self._merged_node}
         self._object_nodes = []
         for code, (mesh, matrix) in enumerate(zip(self._meshes, self._matrices, strict=True), 1):
-            node = self._add(pr.Mesh([_primitive(pr, mesh)]), pose=matrix)
+            node = self._add(pr.Mesh([primitive(pr, untextured(mesh))]), pose=matrix)
             node.mesh.is_visible = False
             self._object_nodes.append(node)
             self._seg_map[node] = np.array([code & 255, (code >> 8) & 255, code >> 16])
@@ -216,26 +237,27 @@ class Renderer:
     def update_poses(self, scene: SceneGeometry) -> bool:
         """Move the loaded objects to a new layout of the same room.
 
-        Returns ``False`` when only poses changed (the merged RGB mesh is re-merged from the
-        kept meshes, object nodes of the id scene are moved), ``True`` when the instance set
-        (or a mesh) differed and the scenes were rebuilt.
+        Returns ``False`` when only poses and looks changed (the merged RGB mesh is re-merged
+        from the new meshes, with their colours and textures; object nodes of the id scene are
+        moved; the light is set), ``True`` when the instance set, an object's shape or the
+        structure differed and the scenes were rebuilt.
         """
         same = (
             self._scene is not None
             and tuple(int(o.instance) for o in scene.objects) == self._instances
             and len(scene.structure) == len(self._structure)
-            and all(_same_mesh(o.mesh, m) for o, m in zip(scene.objects, self._meshes, strict=True))
-            and all(_same_mesh(a, b) for a, b in zip(scene.structure, self._structure, strict=True))
+            and all(same_shape(o.mesh, m) for o, m in zip(scene.objects, self._meshes, strict=True))
+            and all(same_mesh(a, b) for a, b in zip(scene.structure, self._structure, strict=True))
         )
         if not same:
             self.load(scene)
             return True
+        self._meshes = [obj.mesh for obj in scene.objects]
         self._matrices = [np.asarray(o.matrix) for o in scene.objects]
         self._scene.remove_node(self._merged_node)
         self._rank.pop(self._merged_node, None)
-        self._merged_node = self._add(
-            self._pr.Mesh([_primitive(self._pr, _merged_world(scene.objects))])
-        )
+        self._merged_node = self._add(self._pr.Mesh(self._primitives(merged_world(scene.objects))))
+        self._set_lighting(scene.lighting)
         for node, matrix in zip(self._object_nodes, self._matrices, strict=True):
             self._scene.set_pose(node, matrix)
         self._rc = None  # rebuilt lazily with the new world vertices
@@ -256,7 +278,8 @@ class Renderer:
     ) -> RenderedView:
         """RGB, instance ids and depth from the agent pose (x, y, heading ``theta`` rad).
 
-        ``rng`` jitters light intensities by up to +-20 % (off when None).
+        ``rng`` jitters light intensities by up to +-20 % (off when None), on top of the
+        stage's own light.
         """
         rgb, depth = self.render_rgb(x, y, theta, rng=rng)
         return RenderedView(rgb=rgb, instance=self.render_ids(x, y, theta), depth=depth)
@@ -266,7 +289,8 @@ class Renderer:
     ) -> tuple[np.ndarray, np.ndarray]:
         """The RGB pass only: (rgb uint8 HxWx3, depth float32 HxW)."""
         self._require_scene()
-        key, fill = self.key_intensity, self.fill_intensity
+        scale = self._lighting.intensity
+        key, fill = self.key_intensity * scale, self.fill_intensity * scale
         if rng is not None:
             key *= float(rng.uniform(0.8, 1.2))
             fill *= float(rng.uniform(0.8, 1.2))
@@ -335,6 +359,47 @@ class Renderer:
         self.close()
 
     # -- internals --------------------------------------------------------------------------
+
+    def _set_lighting(self, lighting: Lighting) -> None:
+        """The stage's light: colours of the key, fill and ambient light (intensities are
+        scaled in :meth:`render_rgb`)."""
+        self._lighting = lighting
+        color = np.asarray(lighting.color, dtype=np.float64)
+        self._key.color = color
+        self._fill.color = color
+        self._scene.ambient_light = self.ambient * lighting.intensity * color
+
+    def _primitives(self, mesh: MeshData, *, double_sided: bool = False) -> list[Any]:
+        """The RGB primitives of a mesh: untextured faces first, then one per texture file."""
+        if not (self.textures and mesh.textured):
+            return [primitive(self._pr, mesh, double_sided=double_sided)]
+        which = np.asarray(mesh.face_texture)
+        out = []
+        if (which < 0).any():
+            out.append(primitive(self._pr, subset(mesh, which < 0), double_sided=double_sided))
+        for k, path in enumerate(mesh.textures):
+            pick = which == k
+            if pick.any():
+                texture = self._texture(path)
+                out.append(
+                    primitive(
+                        self._pr, subset(mesh, pick), double_sided=double_sided, texture=texture
+                    )
+                )
+        return out
+
+    def _texture(self, path: str) -> Any:
+        """The pyrender texture of an image file, decoded once per renderer."""
+        if path not in self._texture_cache:
+            from PIL import Image
+
+            try:
+                with Image.open(path) as image:
+                    pixels = np.asarray(image.convert("RGB"), dtype=np.uint8)
+            except OSError as exc:
+                raise RenderError(f"{path}: cannot read texture image ({exc})") from None
+            self._texture_cache[path] = self._pr.Texture(source=pixels, source_channels="RGB")
+        return self._texture_cache[path]
 
     def _require_scene(self) -> None:
         if self._scene is None:
@@ -434,47 +499,6 @@ def _multisampling_off() -> Iterator[None]:
         yield
     finally:
         pyrender_renderer.glEnable = original
-
-
-def _merged_world(objects: tuple[ObjectGeometry, ...]) -> MeshData:
-    """All objects' meshes moved into world space and concatenated into one mesh."""
-    return merge_meshes(
-        [MeshData(o.world_vertices(), o.mesh.faces, o.mesh.face_colors) for o in objects]
-    )
-
-
-def _same_mesh(a: MeshData, b: MeshData) -> bool:
-    """Equal geometry and colours (layouts read from USD carry fresh but equal arrays)."""
-    if a is b:
-        return True
-    return (
-        np.array_equal(a.vertices, b.vertices)
-        and np.array_equal(a.faces, b.faces)
-        and np.array_equal(a.face_colors, b.face_colors)
-    )
-
-
-def _primitive(pr: Any, mesh: MeshData, *, double_sided: bool = False) -> Any:
-    """A flat-shaded pyrender primitive with per-face colours (vertices unshared per face)."""
-    v = np.asarray(mesh.vertices, dtype=np.float64)
-    f = np.asarray(mesh.faces, dtype=np.int64)
-    tri = v[f]  # (F, 3, 3)
-    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
-    colors = np.ones((len(f), 4), dtype=np.float32)
-    colors[:, :3] = np.asarray(mesh.face_colors, dtype=np.float32)
-    material = pr.MetallicRoughnessMaterial(
-        baseColorFactor=[1.0, 1.0, 1.0, 1.0],
-        metallicFactor=0.0,
-        roughnessFactor=0.9,
-        doubleSided=double_sided,
-    )
-    return pr.Primitive(
-        positions=tri.reshape(-1, 3).astype(np.float32),
-        normals=np.repeat(n, 3, axis=0).astype(np.float32),
-        color_0=np.repeat(colors, 3, axis=0),
-        material=material,
-    )
 
 
 def _ceiling_light_pose(scene: SceneGeometry) -> np.ndarray:

@@ -4,21 +4,29 @@ Any stage whose object prims carry ``sgdata:class`` or ``sgdata:instance`` rende
 tool wrote it: such a prim is an object, every mesh beneath it is part of that object (expressed in
 the object's local frame), and every other mesh is structure (in world space). Faces with more
 than three corners are fanned into triangles; ``primvars:displayColor`` gives the face colours
-(constant, uniform, vertex and faceVarying interpolation; grey when absent).
+(constant, uniform, vertex and faceVarying interpolation; grey when absent). Bound materials
+override it where they say more (:mod:`sgdata.usd.bound_materials`): a textured face carries
+its texture file and coordinates, and the texture's colour factor as its face colour. The
+stage's light (``sgdata:light:*`` on its room prim, :mod:`sgdata.usd.looks`) comes back as
+:class:`~sgdata.usd.meshes.Lighting`.
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 from pxr import Usd, UsdGeom
 
+from sgdata.usd.bound_materials import MaterialReader
 from sgdata.usd.gprims import tessellate_gprim
-from sgdata.usd.meshes import MeshData, ObjectGeometry, SceneGeometry, merge_meshes
+from sgdata.usd.looks import LIGHT_INTENSITY, LIGHT_TEMPERATURE
+from sgdata.usd.meshes import Lighting, MeshData, ObjectGeometry, SceneGeometry, merge_meshes
 from sgdata.usd.object_prims import drawn_prims, instance_ids, is_object
 from sgdata.usd.stage import open_stage
-from sgdata.usd.stage_frame import stage_frame
+from sgdata.usd.stage_frame import room_prim, stage_frame
+from sgdata.world.appearance import light_color
 from sgdata.world.scene import transform_points
 
 __all__ = ["DEFAULT_COLOR", "read_geometry", "stage_geometry"]
@@ -50,25 +58,26 @@ def stage_geometry(stage: Usd.Stage, path: Path) -> SceneGeometry:
     owners: dict[str, Usd.Prim] = {}  # object prim path -> prim, in traversal order
     parts: dict[str, list[MeshData]] = {}
     structure = []
+    materials = MaterialReader()
     for prim in drawn_prims(stage):
         if is_object(prim):
             owners[str(prim.GetPath())] = prim
             parts.setdefault(str(prim.GetPath()), [])
-        found = _prim_triangles(prim)
+        found = _prim_triangles(prim, materials)
         if found is None:
             continue
-        vertices, faces, colors = found
         world = _world(cache, prim, frame)
         owner = _owner(prim, owners)
         if owner is None:
-            structure.append(
-                MeshData(transform_points(world, vertices), faces, colors, str(prim.GetPath()))
-            )
+            vertices = transform_points(world, found.vertices)
+            structure.append(replace(found, vertices=vertices, name=str(prim.GetPath())))
         else:
             to_owner = np.linalg.inv(_world(cache, owner, frame)) @ world
-            parts[str(owner.GetPath())].append(
-                MeshData(transform_points(to_owner, vertices), faces, colors)
-            )
+            if not np.allclose(to_owner, np.eye(4), rtol=0.0, atol=1e-12):
+                found = replace(found, vertices=transform_points(to_owner, found.vertices))
+            # else: a mesh in its object's own frame keeps its exact vertices, so a moved
+            # object's mesh equals the unmoved one (the renderer then only re-poses it)
+            parts[str(owner.GetPath())].append(found)
     ids = instance_ids(path, list(owners.values()))
     objects = []
     for key, prim in owners.items():
@@ -81,20 +90,40 @@ def stage_geometry(stage: Usd.Stage, path: Path) -> SceneGeometry:
                 matrix=_world(cache, prim, frame),
             )
         )
-    return SceneGeometry(structure=tuple(structure), objects=tuple(objects))
+    return SceneGeometry(
+        structure=tuple(structure), objects=tuple(objects), lighting=_lighting(stage)
+    )
 
 
-def _prim_triangles(prim: Usd.Prim) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+def _lighting(stage: Usd.Stage) -> Lighting:
+    """The light the stage's room prim asks for (defaults: scale 1, white)."""
+    root = room_prim(stage)
+    if not root or not root.IsValid():
+        return Lighting()
+    intensity = (
+        root.GetAttribute(LIGHT_INTENSITY).Get() if root.HasAttribute(LIGHT_INTENSITY) else None
+    )
+    kelvin = (
+        root.GetAttribute(LIGHT_TEMPERATURE).Get() if root.HasAttribute(LIGHT_TEMPERATURE) else None
+    )
+    return Lighting(
+        intensity=1.0 if intensity is None else float(intensity),
+        temperature=None if kelvin is None else float(kelvin),
+        color=(1.0, 1.0, 1.0) if kelvin is None else light_color(float(kelvin)),
+    )
+
+
+def _prim_triangles(prim: Usd.Prim, materials: MaterialReader) -> MeshData | None:
     """The triangles of a mesh or a tessellated gprim in its own frame; ``None`` for others."""
     if prim.IsA(UsdGeom.Mesh):
-        return _triangles(UsdGeom.Mesh(prim))
+        return _triangles(UsdGeom.Mesh(prim), materials)
     if prim.IsA(UsdGeom.Gprim):
         found = tessellate_gprim(prim)
         if found is None:
             return None
         vertices, faces = found
         colors = _face_colors(UsdGeom.Gprim(prim), np.full(len(faces), 3))
-        return vertices, faces, colors
+        return MeshData(vertices, faces, colors)
     return None
 
 
@@ -112,8 +141,9 @@ def _world(cache: UsdGeom.XformCache, prim: Usd.Prim, frame: np.ndarray | None) 
     return m if frame is None else frame @ m
 
 
-def _triangles(mesh: UsdGeom.Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Fan-triangulate a mesh; colours per triangle from its displayColor primvar."""
+def _triangles(mesh: UsdGeom.Mesh, materials: MaterialReader) -> MeshData:
+    """Fan-triangulate a mesh; colours per triangle from its displayColor primvar, then from
+    its bound materials (with their textures)."""
     points = mesh.GetPointsAttr().Get()
     counts = mesh.GetFaceVertexCountsAttr().Get()
     indices = mesh.GetFaceVertexIndicesAttr().Get()
@@ -121,7 +151,7 @@ def _triangles(mesh: UsdGeom.Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     counts = np.array(counts, dtype=np.int64) if counts else np.zeros(0, np.int64)
     indices = np.array(indices, dtype=np.int64) if indices else np.zeros(0, np.int64)
     if counts.sum() != len(indices) or (len(indices) and indices.max() >= len(vertices)):
-        return np.zeros((0, 3)), np.zeros((0, 3), np.int32), np.zeros((0, 3), np.float32)
+        return MeshData(np.zeros((0, 3)), np.zeros((0, 3), np.int32), np.zeros((0, 3), np.float32))
     starts = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
     tri_counts = np.maximum(counts - 2, 0)
     face_of = np.repeat(np.arange(len(counts)), tri_counts)  # source face of each triangle
@@ -135,7 +165,18 @@ def _triangles(mesh: UsdGeom.Mesh) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         corner_colors = _corner_colors(mesh, indices, len(vertices))
         if corner_colors is not None:  # per-vertex / face-varying: average over the triangle
             colors = corner_colors[corners].mean(axis=1).astype(np.float32)
-    return vertices, faces, colors
+    bound = materials.faces(mesh, colors, face_of, corners, indices)
+    if bound is None:
+        return MeshData(vertices, faces, colors)
+    textured = bool((bound.face_texture >= 0).any())
+    return MeshData(
+        vertices,
+        faces,
+        bound.colors,
+        uvs=bound.uvs if textured else None,
+        face_texture=bound.face_texture if textured else None,
+        textures=bound.files if textured else (),
+    )
 
 
 def _display_color(mesh: UsdGeom.Gprim) -> tuple[np.ndarray, str] | None:

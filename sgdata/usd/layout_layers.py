@@ -4,7 +4,8 @@ A layout layer sublayers ``./room.usda`` and holds only ``over`` specs for
 ``/Room/Objects/<prim>``: ``xformOp:translate`` and ``xformOp:rotateZ`` for an object whose
 placement differs from the room's, and ``sgdata:support`` where its support changed (an
 explicit empty target list when it now rests on the floor). Read a layout's composed room with
-:func:`sgdata.usd.room_io.read_room`.
+:func:`sgdata.usd.room_io.read_room`. A layout that draws its own appearance also overrides its
+light and the looks of its low- and high-dynamic objects (:mod:`sgdata.usd.looks`).
 
 Provenance lives in the layer's ``customLayerData``: ``sgdata:layout`` (int, the layout index),
 ``sgdata:seed`` (int64) and ``sgdata:moves``, a JSON string holding the list of move records
@@ -24,9 +25,11 @@ from pxr import Gf, Sdf, UsdGeom, Vt
 
 from sgdata.errors import SceneError, UsdError
 from sgdata.scene_files import ROOM_FILE
+from sgdata.usd.looks import RoomParts, define_layout_materials, override_light, override_look
 from sgdata.usd.own_layouts import OwnFrame, override_own
 from sgdata.usd.room_io import ROOT, object_path
 from sgdata.usd.stage import open_layer, write_text_atomic
+from sgdata.world.appearance import LayoutAppearance
 from sgdata.world.scene import Room, SceneObject
 
 __all__ = ["PLACEMENT_TOLERANCE", "write_layout", "read_layout_provenance"]
@@ -45,6 +48,8 @@ def write_layout(
     seed: int,
     moves: list[dict],
     own: OwnFrame | None = None,
+    appearance: LayoutAppearance | None = None,
+    parts: RoomParts | None = None,
 ) -> None:
     """Write ``layout`` as a layer over ``base``, atomically and byte-reproducibly.
 
@@ -57,6 +62,9 @@ def write_layout(
         moves: one record per object move (JSON-able values), stored as provenance.
         own: for a room authored elsewhere (:func:`sgdata.usd.own_layouts.own_frame`): its
             prim paths and frame; moves are then written as each prim's local matrix.
+        appearance: the layout's light and object looks (:func:`sgdata.world.appearance.
+            sample_appearance`), written with ``parts`` (:func:`sgdata.usd.looks.
+            read_room_parts` of the room); ``None`` keeps the room's looks and light.
 
     Raises:
         SceneError: ``layout`` does not hold the same objects as ``base``, or the moves are
@@ -89,6 +97,7 @@ def write_layout(
         _KEY_SEED: Vt.Int64(int(seed)),
         _KEY_MOVES: moves_json,
     }
+    materials: dict = {}  # tinted materials the new looks use, defined after the objects
     for old in base.objects:  # in room order, so the composed prim order stays the room's
         new = after[old.instance]
         if new.class_name != old.class_name:
@@ -97,6 +106,11 @@ def write_layout(
                 f"but a {old.class_name} in room {base.room_id}"
             )
         _override(layer, old, new, before, after, own)
+        if appearance is not None and parts is not None and old.instance in appearance.looks:
+            override_look(layer, parts, old.instance, appearance.looks[old.instance], materials)
+    if appearance is not None and parts is not None:
+        define_layout_materials(layer, materials)
+        override_light(layer, parts, appearance)
     write_text_atomic(path, layer.ExportToString())
 
 

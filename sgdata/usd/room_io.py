@@ -13,6 +13,11 @@ override it)::
                                instance, size (float3), variant, color (color3f); rel
                                sgdata:support and sgdata:attachedTo (only when set)
     /Room/Objects/<prim>/Geom  Mesh in the object's local frame, triangles, uniform displayColor
+                               indexed: one value per part (distinct colour), one index per face
+
+Written with an appearance, a room also records each object's look and, with textures, holds
+materials, texture coordinates and per-part bindings (:mod:`sgdata.usd.looks`,
+:mod:`sgdata.usd.materials`).
 
 A door's ``center`` is measured along its wall from the wall's low-coordinate end: from x = 0
 on the south and north walls, from y = 0 on the east and west walls. ``sgdata:size`` and
@@ -35,6 +40,8 @@ from sgdata.usd.stage import open_stage, write_text_atomic
 from sgdata.world.scene import WALLS, Dynamics, Opening, Placement, Room, SceneObject
 
 if TYPE_CHECKING:
+    from sgdata.usd.looks import RoomDresser
+    from sgdata.world.appearance import AppearanceConfig
     from sgdata.world.catalog import Catalog
 
 __all__ = [
@@ -98,13 +105,25 @@ def catalog_geometry(catalog: Catalog | None = None) -> Geometry:
 # ---------------------------------------------------------------------------------- writing
 
 
-def write_room(room: Room, path: Path, *, geometry: Geometry) -> None:
+def write_room(
+    room: Room,
+    path: Path,
+    *,
+    geometry: Geometry,
+    appearance: AppearanceConfig | None = None,
+    textures: Path | None = None,
+) -> None:
     """Write ``room`` as a USD stage at ``path``, atomically and byte-reproducibly.
 
     Args:
         room: the room to write; its objects become prims in ``room.objects`` order.
         path: the ``.usda`` file to write (its folder is created if missing).
         geometry: local-frame mesh of an object (see :func:`catalog_geometry`).
+        appearance: record the room's base looks (:func:`sgdata.world.appearance.room_looks`)
+            and, with ``appearance.textures``, dress every surface in textured materials;
+            ``None`` writes flat colours only.
+        textures: the folder of the texture images (written there if missing); default
+            :func:`sgdata.scene_files.textures_dir` of ``path``'s folder.
 
     Raises:
         SceneError: an object's support or owner is not in the room, or its mesh is malformed.
@@ -127,15 +146,24 @@ def write_room(room: Room, path: Path, *, geometry: Geometry) -> None:
     if room.door.bottom != 0.0:  # a door has none; kept so other openings round-trip too
         _set(root, "sgdata:door:bottom", _DOUBLE, room.door.bottom)
 
+    dresser = None
+    if appearance is not None:
+        from sgdata.usd.looks import RoomDresser  # late: materials pull in Pillow and textures
+
+        dresser = RoomDresser(stage, room, Path(path), appearance, textures)
     UsdGeom.Xform.Define(stage, STRUCTURE)
     for name, (vertices, faces, colors) in _structure_meshes(room).items():
-        _define_mesh(stage, STRUCTURE.AppendChild(name), vertices, faces, colors)
+        mesh, _ = _define_mesh(stage, STRUCTURE.AppendChild(name), vertices, faces, colors)
+        if dresser is not None:
+            dresser.structure(name, mesh, vertices, faces, tuple(colors[0]))
 
     group = UsdGeom.Xform.Define(stage, OBJECTS).GetPrim()
     Usd.ModelAPI(group).SetKind(Kind.Tokens.group)
     by_instance = room.by_instance()
     for obj in room.objects:
-        _define_object(stage, obj, by_instance, geometry)
+        _define_object(stage, obj, by_instance, geometry, dresser)
+    if dresser is not None:
+        dresser.finish()
     write_text_atomic(path, stage.GetRootLayer().ExportToString())
 
 
@@ -145,7 +173,11 @@ def object_path(obj: SceneObject) -> Sdf.Path:
 
 
 def _define_object(
-    stage: Usd.Stage, obj: SceneObject, by_instance: dict[int, SceneObject], geometry: Geometry
+    stage: Usd.Stage,
+    obj: SceneObject,
+    by_instance: dict[int, SceneObject],
+    geometry: Geometry,
+    dresser: RoomDresser | None,
 ) -> None:
     where = f"object {obj.prim_name}"
     xform = UsdGeom.Xform.Define(stage, object_path(obj))
@@ -171,12 +203,16 @@ def _define_object(
         rel = prim.CreateRelationship(rel_name, custom=True)
         rel.SetTargets([object_path(by_instance[target])])
     vertices, faces, colors = _checked_mesh(where, *geometry(obj))
-    _define_mesh(stage, object_path(obj).AppendChild("Geom"), vertices, faces, colors)
+    mesh, parts = _define_mesh(stage, object_path(obj).AppendChild("Geom"), vertices, faces, colors)
+    if dresser is not None:
+        dresser.object(prim, obj, mesh, vertices, faces, parts)
 
 
 def _define_mesh(
     stage: Usd.Stage, path: Sdf.Path, vertices: np.ndarray, faces: np.ndarray, colors: np.ndarray
-) -> None:
+) -> tuple[UsdGeom.Mesh, np.ndarray]:
+    """A triangle mesh with an indexed uniform displayColor; returns it and the part
+    (index of its colour among the distinct colours, in order of first use) of each face."""
     mesh = UsdGeom.Mesh.Define(stage, path)
     points = Vt.Vec3fArray.FromNumpy(np.ascontiguousarray(vertices, dtype=np.float32))
     mesh.CreatePointsAttr(points)
@@ -187,8 +223,23 @@ def _define_mesh(
     mesh.CreateExtentAttr(UsdGeom.Mesh.ComputeExtent(points))
     mesh.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
     mesh.CreateDoubleSidedAttr(False)
+    values, parts = _parts(np.asarray(colors, dtype=np.float32).reshape(-1, 3))
     primvar = mesh.CreateDisplayColorPrimvar(UsdGeom.Tokens.uniform)
-    primvar.Set(Vt.Vec3fArray.FromNumpy(np.ascontiguousarray(colors, dtype=np.float32)))
+    primvar.Set(Vt.Vec3fArray.FromNumpy(values))
+    primvar.SetIndices(Vt.IntArray.FromNumpy(parts))
+    return mesh, parts
+
+
+def _parts(colors: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct colours in order of first use, and each face's index into them."""
+    if not len(colors):
+        return np.zeros((0, 3), np.float32), np.zeros(0, np.int32)
+    unique, first, inverse = np.unique(colors, axis=0, return_index=True, return_inverse=True)
+    order = np.argsort(first, kind="stable")
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    values = np.ascontiguousarray(unique[order], dtype=np.float32)
+    return values, rank[inverse.reshape(-1)].astype(np.int32)
 
 
 def _checked_mesh(

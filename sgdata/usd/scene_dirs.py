@@ -7,10 +7,12 @@ from pathlib import Path
 from sgdata.errors import ConfigError, SceneError
 from sgdata.fileio import prepare_output_dir
 from sgdata.scene_files import LAYOUT_FILE, ROOM_FILE, layout_file, room_file
-from sgdata.seeds import layouts_seed
+from sgdata.seeds import appearance_seed, layouts_seed
 from sgdata.usd.layout_layers import write_layout
+from sgdata.usd.looks import read_room_parts
 from sgdata.usd.own_layouts import own_frame
 from sgdata.usd.room_io import catalog_geometry, read_room, write_room
+from sgdata.world.appearance import AppearanceConfig, sample_appearance
 from sgdata.world.catalog import Catalog, load_catalog
 from sgdata.world.dynamics import DynamicsConfig, Layout, sample_layouts
 from sgdata.world.poses import PosesConfig
@@ -36,8 +38,12 @@ def write_rooms(
     seed: int,
     first_index: int = 0,
     catalog: Catalog | None = None,
+    appearance: AppearanceConfig | None = None,
 ) -> list[Room]:
     """Generate ``count`` rooms of ``room_type`` and write each as ``out/<room_id>/room.usda``.
+
+    With ``appearance`` the rooms record their looks and (``appearance.textures``) are
+    textured, their images shared in ``out/textures/``.
 
     Raises:
         ConfigError: bad count, room type or output directory (checked before any write).
@@ -49,7 +55,7 @@ def write_rooms(
     prepare_output_dir(out)
     geometry = catalog_geometry(catalog)
     for room in rooms:
-        write_room(room, room_file(out / room.room_id), geometry=geometry)
+        write_room(room, room_file(out / room.room_id), geometry=geometry, appearance=appearance)
     return rooms
 
 
@@ -78,11 +84,16 @@ def write_layouts(
     catalog: Catalog | None = None,
     config: DynamicsConfig | None = None,
     poses: PosesConfig | None = None,
+    appearance: AppearanceConfig | None = None,
 ) -> list[Layout]:
     """Sample ``count`` layouts of the room in ``room_dir`` and write ``layout_<k>.usda``.
 
-    Layout 0 is the base arrangement (a layer with no overrides). The layouts' seed is derived
-    from the room's own seed and ``seed``, so two rooms given the same ``seed`` differ.
+    Layout 0 is the base arrangement (a layer with no moves). The layouts' seed is derived
+    from the room's own seed and ``seed``, so two rooms given the same ``seed`` differ. With
+    ``appearance.randomize`` every layout, 0 included, also draws its light and the looks of
+    its low- and high-dynamic objects (:func:`sgdata.seeds.appearance_seed` of its seed); a
+    room written without an appearance, or authored elsewhere, keeps its looks (only its
+    light changes).
     """
     if count < 1:
         raise ConfigError(f"--count must be >= 1, got {count}")
@@ -92,7 +103,13 @@ def write_layouts(
         base, count, layouts_seed(base.seed, seed), catalog, config, poses=poses
     )
     own = own_frame(room_file(room_dir))  # None for rooms written by 'sgdata rooms'
+    parts = None
+    if appearance is not None and appearance.randomize:
+        parts = read_room_parts(room_file(room_dir))
     for layout in layouts:
+        drawn = None
+        if parts is not None and appearance is not None:
+            drawn = sample_appearance(base, appearance, appearance_seed(layout.seed))
         write_layout(
             base,
             layout.room,
@@ -101,6 +118,8 @@ def write_layouts(
             seed=layout.seed,
             moves=[m.as_dict() for m in layout.moves],
             own=own,
+            appearance=drawn,
+            parts=parts,
         )
     return layouts
 

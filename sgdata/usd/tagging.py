@@ -5,6 +5,11 @@ it, a room directory that ``sgdata layouts`` and ``sgdata render`` take) sublaye
 ``over`` specs with only the ``sgdata:*`` values the file lacks, measured by
 :mod:`sgdata.usd.own_rooms`, plus ``sgdata:roomOrigin`` and ``sgdata:placements = "measured"``
 (objects keep their own frames; placements are measured from geometry on every read).
+Objects whose class the class file makes an alias get the catalog class as ``sgdata:class``.
+
+``sgdata generate`` tags the rooms of ``[rooms] files`` the same way, over a flattened copy of
+the user's stage inside the dataset (:func:`write_flattened`), naming each room's id, type and
+seed itself.
 """
 
 from __future__ import annotations
@@ -24,9 +29,9 @@ from sgdata.usd.stage_frame import ROOM_ORIGIN, room_prim
 from sgdata.world.catalog import Catalog, load_catalog
 from sgdata.world.room_checks import room_problems
 from sgdata.world.scene import Room
-from sgdata.world.user_classes import load_user_classes
+from sgdata.world.user_classes import read_class_file
 
-__all__ = ["TagReport", "default_output", "tag_stage"]
+__all__ = ["RoomNames", "TagReport", "default_output", "tag_stage", "write_flattened"]
 
 
 @dataclass(frozen=True)
@@ -41,6 +46,15 @@ class TagReport:
     usd_problems: tuple[str, ...]  # what USD's validators report on the tagged stage
 
 
+@dataclass(frozen=True)
+class RoomNames:
+    """Room-prim values the tag layer authors even over the user's own (``sgdata generate``)."""
+
+    room_id: str
+    room_type: str
+    seed: int
+
+
 def default_output(stage_path: Path) -> Path:
     """``<folder>/<stem>_sgdata/room.usda``: a room directory beside the user's file."""
     return stage_path.parent / f"{stage_path.stem}_sgdata" / ROOM_FILE
@@ -52,14 +66,21 @@ def tag_stage(
     classes: Path | None = None,
     output: Path | None = None,
     catalog: Catalog | None = None,
+    names: RoomNames | None = None,
+    checks: bool = True,
 ) -> TagReport:
     """Write the tag layer of ``stage_path`` and read the tagged room back.
 
     Args:
         stage_path: the user's USD file (any up axis and ``metersPerUnit``).
-        classes: a class file naming non-catalog classes with their dynamics.
+        classes: a class file naming non-catalog classes with their dynamics, or aliases of
+            catalog classes (:mod:`sgdata.world.user_classes`).
         output: the tag layer to write (default :func:`default_output`).
         catalog: the catalog giving known classes' dynamics (the shipped one when ``None``).
+        names: the room's id, type and seed, authored whatever the file says (default: the
+            file's own values, else its stem, ``custom`` and 0).
+        checks: run the physical checks and USD's validators for the report (``problems``
+            and ``usd_problems`` stay empty without).
 
     Raises:
         ConfigError: ``output`` would overwrite the user's file.
@@ -70,9 +91,9 @@ def tag_stage(
     if out.resolve() == source.resolve():
         raise ConfigError(f"{out}: is the stage itself; the user's file is never written")
     catalog = catalog or load_catalog()
-    user_classes = load_user_classes(classes)
+    user_classes = read_class_file(classes, catalog)
     stage = open_stage(source)
-    measured = measure_stage(stage, source, classes=user_classes, catalog=catalog)
+    measured = measure_stage(stage, source, classes=user_classes.dynamics, catalog=catalog)
     layer = Sdf.Layer.CreateAnonymous(".usda")
     layer.subLayerPaths.append(_relative(source, out.parent))
     root = room_prim(stage)
@@ -82,10 +103,15 @@ def tag_stage(
     layer.pseudoRoot.SetInfo(
         UsdGeom.Tokens.metersPerUnit, float(UsdGeom.GetStageMetersPerUnit(stage)) if units else 1.0
     )
-    _tag_room(layer, root, measured.room, measured.origin)
+    _tag_room(layer, root, measured.room, measured.origin, names)
     by_instance = measured.room.by_instance()
     for instance, key in measured.paths.items():
-        _tag_object(layer, stage.GetPrimAtPath(key), by_instance[instance], measured.paths)
+        obj = by_instance[instance]
+        _tag_object(layer, stage.GetPrimAtPath(key), obj, measured.paths)
+        alias = user_classes.aliases.get(obj.class_name)
+        if alias is not None:  # the catalog class it stands for, over the user's name
+            spec = _spec(layer, stage.GetPrimAtPath(key))
+            _attr(spec, None, "sgdata:class", Sdf.ValueTypeNames.String, alias)
     write_text_atomic(out, layer.ExportToString())
     room = read_room(out)
     return TagReport(
@@ -93,9 +119,25 @@ def tag_stage(
         output=out,
         room=room,
         inferred=measured.inferred,
-        problems=_problems(room, catalog),
-        usd_problems=tuple(validate_stage(out)),
+        problems=_problems(room, catalog) if checks else (),
+        usd_problems=tuple(validate_stage(out)) if checks else (),
     )
+
+
+def write_flattened(source: Path, output: Path, *, doc: str) -> None:
+    """Write the composed stage of ``source`` as one self-contained layer at ``output``.
+
+    Sublayers, references and variants are resolved into it, so a dataset's copy of a user's
+    room depends on no file outside the dataset. ``doc`` replaces the layer's documentation
+    (USD's default names the absolute path of ``source``, which would make the bytes depend on
+    where the file lies).
+
+    Raises:
+        UsdError: ``source`` cannot be opened or composed, or ``output`` cannot be written.
+    """
+    layer = open_stage(Path(source)).Flatten()
+    layer.documentation = doc
+    write_text_atomic(Path(output), layer.ExportToString())
 
 
 def _relative(source: Path, folder: Path) -> str:
@@ -108,21 +150,33 @@ def _spec(layer: Sdf.Layer, prim: Usd.Prim) -> Sdf.PrimSpec:
 
 
 def _attr(
-    spec: Sdf.PrimSpec, prim: Usd.Prim, name: str, type_name: Sdf.ValueTypeName, value: object
+    spec: Sdf.PrimSpec,
+    prim: Usd.Prim | None,
+    name: str,
+    type_name: Sdf.ValueTypeName,
+    value: object,
 ) -> None:
-    """Author ``name`` on the over when the user's prim lacks a value for it."""
-    attr = prim.GetAttribute(name)
+    """Author ``name`` on the over when the user's prim lacks a value for it (always when
+    ``prim`` is ``None``)."""
+    attr = prim.GetAttribute(name) if prim is not None else None
     if attr and attr.Get() is not None:
         return
     Sdf.AttributeSpec(spec, name, type_name, Sdf.VariabilityVarying, True).default = value
 
 
-def _tag_room(layer: Sdf.Layer, root: Usd.Prim, room: Room, origin: tuple) -> None:
+def _tag_room(
+    layer: Sdf.Layer, root: Usd.Prim, room: Room, origin: tuple, names: RoomNames | None
+) -> None:
     spec = _spec(layer, root)
     types = Sdf.ValueTypeNames
-    _attr(spec, root, "sgdata:roomId", types.String, room.room_id)
-    _attr(spec, root, "sgdata:roomType", types.Token, room.room_type)
-    _attr(spec, root, "sgdata:seed", types.Int64, room.seed)
+    if names is None:
+        _attr(spec, root, "sgdata:roomId", types.String, room.room_id)
+        _attr(spec, root, "sgdata:roomType", types.Token, room.room_type)
+        _attr(spec, root, "sgdata:seed", types.Int64, room.seed)
+    else:  # authored over whatever the user's file says
+        _attr(spec, None, "sgdata:roomId", types.String, names.room_id)
+        _attr(spec, None, "sgdata:roomType", types.Token, names.room_type)
+        _attr(spec, None, "sgdata:seed", types.Int64, names.seed)
     _attr(
         spec, root, "sgdata:roomSize", types.Double3, Gf.Vec3d(room.width, room.depth, room.height)
     )

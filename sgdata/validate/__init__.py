@@ -2,8 +2,8 @@
 
 One entry point, :func:`validate_dataset`, runs the check families in order (see
 docs/validate.md): manifest, files, tables, rows/objects/relations, relation recompute,
-triplets, images, scenes. Nothing stops at the first failure: the report lists every
-:class:`Problem` with its file, row and field.
+triplets, images, scenes, and with ``sources`` the user room files. Nothing stops at the
+first failure: the report lists every :class:`Problem` with its file, row and field.
 """
 
 from __future__ import annotations
@@ -12,6 +12,7 @@ import time
 from pathlib import Path
 
 from sgdata.dataset.schema import FORMAT_VERSION, _parse_version
+from sgdata.validate.appearance_checks import check_appearance
 from sgdata.validate.composition_checks import (
     check_counts,
     check_rooms_across_splits,
@@ -28,13 +29,15 @@ from sgdata.validate.manifest_checks import (
 from sgdata.validate.problems import Collector, Problem, ValidationReport
 from sgdata.validate.relation_checks import check_recompute
 from sgdata.validate.scene_checks import check_scenes
+from sgdata.validate.source_checks import CHECK as SOURCES_CHECK
+from sgdata.validate.source_checks import check_sources, user_room_files
 from sgdata.validate.table_checks import check_ids, compare_schema, load_split
 
 __all__ = ["Problem", "ValidationReport", "compare_schema", "validate_dataset"]
 
 
 def validate_dataset(
-    root: str | Path, *, quick: bool = False, usd: bool = False
+    root: str | Path, *, quick: bool = False, usd: bool = False, sources: Path | None = None
 ) -> ValidationReport:
     """Check the dataset at ``root``; every failure becomes a :class:`Problem`.
 
@@ -42,6 +45,8 @@ def validate_dataset(
         root: the dataset directory (holding ``dataset.json``).
         quick: skip decoding the images (the slowest check).
         usd: also run USD's validators on every referenced scene layer.
+        sources: the folder of the config that generated the dataset: its ``[rooms] files``
+            must still have the sha256 the manifest records.
 
     Returns:
         the report; ``report.ok`` is True only when no check failed.
@@ -55,6 +60,10 @@ def validate_dataset(
     raw = read_raw_manifest(root, out)
     if raw is not None and check_manifest(raw, out):
         _check_contents(root, raw, out, quick=quick, usd=usd)
+        if sources is not None:
+            check_sources(raw, Path(sources), out)
+        elif user_room_files(raw):
+            out.skipped.append(SOURCES_CHECK)
     if quick:
         out.skipped.append("images.decode")
         out.skipped.append("images.size")
@@ -79,6 +88,7 @@ def _check_contents(root: Path, raw: dict, out: Collector, *, quick: bool, usd: 
         splits.append(tables)
         check_ids(tables, out)
         check_rows(tables, raw, out)
+        check_appearance(tables, raw, out)
         objects = check_objects(tables, raw, out)
         if objects is not None:
             relations = check_relations(tables, raw, objects, out)

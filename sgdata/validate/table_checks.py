@@ -12,7 +12,7 @@ import pyarrow.compute as pc
 import pyarrow.parquet as pq
 
 from sgdata.dataset.paths import observations_path, triplets_path
-from sgdata.dataset.schema import observations_schema, triplets_schema
+from sgdata.dataset.schema import FORMAT_VERSION, observations_schema, schema_at, triplets_schema
 from sgdata.validate.loading import SplitTables, column_numpy, read_table_as
 from sgdata.validate.problems import Collector
 
@@ -111,14 +111,19 @@ def _schema_check(root: Path, rel: str, wanted: pa.Schema, out: Collector, extra
 def load_split(
     root: Path, raw: dict[str, Any], split: str, out: Collector, *, extra_ok: bool
 ) -> SplitTables:
-    """Schema-check and read one split's shards (no images) and triplet table."""
+    """Schema-check and read one split's shards (no images) and triplet table.
+
+    Files must hold the columns of the dataset's own format version (``schema_at``); columns a
+    later minor added are read as nulls from an older dataset."""
     obs_schema = observations_schema()
+    version = str(raw.get("format_version", FORMAT_VERSION))
+    obs_wanted = schema_at(obs_schema, version)
     tables, files, file_index, file_row = [], [], [], []
     for room in raw["splits"][split]:
         rel = observations_path(split, room)
         if not (root / rel).is_file():
             continue  # reported by files.exist
-        _schema_check(root, rel, obs_schema, out, extra_ok)
+        _schema_check(root, rel, obs_wanted, out, extra_ok)
         table = read_table_as(root / rel, obs_schema, skip=("image",))
         if table is None:
             out.add(
@@ -133,7 +138,7 @@ def load_split(
     trel = triplets_path(split)
     triplets = None
     if (root / trel).is_file():
-        _schema_check(root, trel, triplets_schema(), out, extra_ok)
+        _schema_check(root, trel, schema_at(triplets_schema(), version), out, extra_ok)
         triplets = read_table_as(root / trel, triplets_schema())
         if triplets is None:
             out.add(

@@ -12,7 +12,15 @@ from typing import Any
 from sgdata.errors import CatalogError
 from sgdata.world.scene import Dynamics
 
-__all__ = ["PLACEMENTS", "ClassSpec", "Catalog", "load_catalog", "default_catalog_path"]
+__all__ = [
+    "PLACEMENTS",
+    "SIDES",
+    "WALL",
+    "ClassSpec",
+    "Catalog",
+    "load_catalog",
+    "default_catalog_path",
+]
 
 # How a class is put into a room:
 #   floor       stands on the floor, anywhere free
@@ -21,6 +29,12 @@ __all__ = ["PLACEMENTS", "ClassSpec", "Catalog", "load_catalog", "default_catalo
 #   surface     rests on a top surface of one of `receptacles` or inside one of `containers`
 #   part        created only as an attached part of another class's recipe (shelf boards)
 PLACEMENTS = ("floor", "wall_floor", "wall", "surface", "part")
+
+# Where a floor object belongs (see sgdata.world.arrangement): `anchors` lists the classes it
+# stands at, facing them, and WALL for "back to a wall"; `anchor_sides` the sides of a class
+# that others may stand at when it is their anchor, in its local frame (front = -Y).
+WALL = "wall"
+SIDES = ("front", "right", "back", "left")
 
 _FIELDS = {
     "dynamics",
@@ -35,6 +49,8 @@ _FIELDS = {
     "palette",
     "variants",
     "description",
+    "anchors",
+    "anchor_sides",
 }
 
 
@@ -55,6 +71,16 @@ class ClassSpec:
     palette: tuple[tuple[float, float, float], ...]  # main colours, linear RGB in [0, 1]
     variants: int  # number of shape variants the recipe offers
     description: str = ""
+    anchors: tuple[str, ...] = ()  # floor classes: what it stands at, in order of preference
+    anchor_sides: tuple[str, ...] = ()  # sides others stand at; () = by placement (see below)
+
+    def sides_to_stand_at(self) -> tuple[str, ...]:
+        """Sides of this class that an object anchored to it may stand at: ``anchor_sides``
+        when given, else every side of a free-standing class and the front of one against a
+        wall (a desk, a bed); none for the rest."""
+        if self.anchor_sides:
+            return self.anchor_sides
+        return {"floor": SIDES, "wall_floor": ("front",)}.get(self.placement, ())
 
 
 @dataclass(frozen=True, eq=False)  # hashed by identity: loaded once, cached
@@ -162,6 +188,14 @@ def _parse_class(path: Path, name: str, entry: Any) -> ClassSpec:
             f"{where}: field 'palette' must be a non-empty list of '#rrggbb' colours"
         )
     colors = tuple(_hex_color(where, c) for c in palette)
+    anchors = _names(where, "anchors", entry.get("anchors", []))
+    if anchors and placement != "floor":
+        raise CatalogError(f"{where}: field 'anchors' is for placement 'floor' only")
+    anchor_sides = _names(where, "anchor_sides", entry.get("anchor_sides", []))
+    if any(side not in SIDES for side in anchor_sides) or len(set(anchor_sides)) < len(
+        anchor_sides
+    ):
+        raise CatalogError(f"{where}: field 'anchor_sides' must list distinct sides of {SIDES}")
     return ClassSpec(
         name=name,
         dynamics=dynamics,
@@ -176,6 +210,8 @@ def _parse_class(path: Path, name: str, entry: Any) -> ClassSpec:
         palette=colors,
         variants=variants,
         description=str(entry.get("description", "")),
+        anchors=anchors,
+        anchor_sides=anchor_sides,
     )
 
 
@@ -222,3 +258,9 @@ def _check_references(path: Path, specs: dict[str, ClassSpec]) -> None:
                     raise CatalogError(
                         f"{path}: class {spec.name}: field {key!r} names unknown class {other!r}"
                     )
+        for other in spec.anchors:
+            if other != WALL and (other not in specs or not specs[other].sides_to_stand_at()):
+                raise CatalogError(
+                    f"{path}: class {spec.name}: field 'anchors' names {other!r}; expected "
+                    f"{WALL!r} or a class standing on the floor"
+                )

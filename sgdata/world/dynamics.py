@@ -5,9 +5,12 @@ Rules (paper §V-A.3, DESIGN §4):
 - low-dynamic objects move locally: a new spot within ``radius_factor * r(B)`` of the old one
   (r(B) = radius of the bounding sphere of the object's box), on the same support, with a yaw
   noise of sigma ``yaw_sigma_deg`` clipped at 3 sigma (the authors used up to 10 degrees);
-- high-dynamic objects relocate anywhere they fit: furniture anywhere on the floor, small
-  objects on any surface of a class that may hold them, with a random yaw;
-- what rests on (or is attached to) a moved object moves with it, rigidly;
+- high-dynamic objects relocate anywhere they fit: small objects on any surface of a class
+  that may hold them, with a random yaw; furniture where its class belongs first
+  (:mod:`sgdata.world.arrangement`: a chair at a table, a desk or a wall, facing it; a stool
+  or an ottoman by the seating), and only in its last tries anywhere free on the floor;
+- what rests on (or is attached to) a moved object moves with it, rigidly, and so does the
+  furniture standing at it (the chairs at a table: rule ``"follow"``);
 - every layout is physically valid (see :mod:`sgdata.world.room_checks`) and keeps the door clear;
   an object whose move fails after ``tries`` attempts stays put, and that is recorded.
 """
@@ -15,12 +18,20 @@ Rules (paper §V-A.3, DESIGN §4):
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from sgdata.errors import ConfigError
 from sgdata.seeds import layout_seed, rng_for
+from sgdata.world.arrangement import (
+    FREE,
+    anchor_objects,
+    draw_spot,
+    stands_at_object,
+    tier_of,
+    tiers_for,
+)
 from sgdata.world.catalog import Catalog
 from sgdata.world.placement import (
     WorldSurface,
@@ -119,7 +130,9 @@ class Move:
 
     instance: int
     class_name: str
-    rule: str  # "low" | "high" | "carried" (moved because its support moved)
+    # "low" | "high" | "carried" (moved because its support moved) | "follow" (moved with the
+    # furniture it stands at: a chair with its table)
+    rule: str
     before: Placement
     after: Placement
     support_before: int | None
@@ -224,6 +237,7 @@ class _LayoutSampler:
             if parent is not None:
                 children.setdefault(parent, []).append(obj.instance)
         self.children = children
+        self.followed: set[int] = set()  # moved with the furniture they stand at
         self.min_reachable = config.min_reachable_share * len(poses.grid(base).cells)
 
     def run(self) -> tuple[Room, list[Move]]:
@@ -245,7 +259,12 @@ class _LayoutSampler:
             self._record(moves, current, self.objects[obj.instance], rule, moved)
         room = self.base.with_objects([self.objects[o.instance] for o in self.base.objects])
         self._record_carried(moves, room)
-        return room, [moves[k] for k in sorted(moves)]
+        # an object may have been carried or followed after its own move: record where it ended
+        final = room.by_instance()
+        return room, [
+            replace(moves[k], after=final[k].placement, support_after=final[k].support)
+            for k in sorted(moves)
+        ]
 
     def _record(
         self,
@@ -277,7 +296,7 @@ class _LayoutSampler:
             moves[obj.instance] = Move(
                 obj.instance,
                 obj.class_name,
-                "carried",
+                "follow" if obj.instance in self.followed else "carried",
                 original.placement,
                 obj.placement,
                 original.support,
@@ -293,11 +312,36 @@ class _LayoutSampler:
             stack.extend(self.children.get(child, []))
         return out
 
+    def _followers(self, obj: SceneObject) -> list[int]:
+        """Furniture standing at ``obj`` (chairs at a table), and at those, transitively."""
+        found: list[int] = []
+        frontier = [obj]
+        while frontier:
+            anchor = frontier.pop(0)
+            for other in self.objects.values():  # base order: deterministic
+                if (
+                    other.instance == obj.instance
+                    or other.instance in found
+                    or other.dynamics is Dynamics.STATIC
+                    or other.support is not None
+                    or other.attached_to is not None
+                    or other.class_name not in self.catalog
+                    or anchor.class_name not in self.catalog[other.class_name].anchors
+                ):
+                    continue
+                if stands_at_object(other, anchor, self.catalog):
+                    found.append(other.instance)
+                    frontier.append(other)
+        return found
+
     def _try(self, obj: SceneObject, propose) -> bool:  # noqa: ANN001
+        followers = self._followers(obj)
         carried = self._descendants(obj.instance)
+        for follower in followers:
+            carried += [follower, *self._descendants(follower)]
         moving = {obj.instance, *carried}
-        for _ in range(self.config.tries):
-            proposal = propose(obj, moving)
+        for attempt in range(self.config.tries):
+            proposal = propose(obj, moving, attempt)
             if proposal is None:
                 continue
             placement, support = proposal
@@ -309,6 +353,7 @@ class _LayoutSampler:
                     self._reparent(obj, support)
                 for item in moved:
                     self.objects[item.instance] = item
+                self.followed.update(followers)
                 return True
         return False
 
@@ -337,7 +382,7 @@ class _LayoutSampler:
         return True
 
     def _low_candidate(
-        self, obj: SceneObject, moving: set[int]
+        self, obj: SceneObject, moving: set[int], attempt: int
     ) -> tuple[Placement, int | None] | None:
         radius = self.config.radius(obj)
         distance = radius * math.sqrt(self.rng.random())  # uniform over the disk
@@ -360,9 +405,16 @@ class _LayoutSampler:
         return placement, obj.support
 
     def _high_candidate(
-        self, obj: SceneObject, moving: set[int]
+        self, obj: SceneObject, moving: set[int], attempt: int
     ) -> tuple[Placement, int | None] | None:
         spec = self.catalog[obj.class_name]
+        if spec.placement in ("floor", "wall_floor") and obj.support is None:
+            # where it belongs first (at a table, a wall, ...), anywhere free in the last tries
+            anchors = anchor_objects(spec, self.objects.values(), self.catalog, exclude=moving)
+            tier = tier_of(attempt, self.config.tries, tiers_for(spec, bool(anchors)))
+            spot = draw_spot(self.rng, tier, anchors, self.base, obj.size)
+            if tier != FREE and spot is not None:
+                return spot, None
         yaw = float(self.rng.uniform(-math.pi, math.pi))
         if spec.placement in ("floor", "wall_floor") and obj.support is None:
             room = self.base
@@ -402,7 +454,7 @@ class LayoutSummary:
 
     share_moved: dict[str, float]
     mean_displacement: dict[str, float]
-    carried: int  # object moves caused only by their support moving
+    carried: int  # object moves caused only by their support (or their anchor) moving
     failed_moves: int  # drawn moves that found no valid spot (the object stayed put)
 
     def lines(self) -> list[str]:
@@ -413,7 +465,7 @@ class LayoutSummary:
                 f"{category:>6}: {100 * share:5.1f} % moved, mean displacement "
                 f"{self.mean_displacement[category]:.2f} m"
             )
-        out.append(f"carried along by a moved support: {self.carried}")
+        out.append(f"carried along by a moved support or anchor: {self.carried}")
         out.append(f"failed moves (stayed put): {self.failed_moves}")
         return out
 
@@ -434,7 +486,7 @@ def summarize_layouts(layouts: list[Layout]) -> LayoutSummary:
                 continue
             if not move.moved:
                 failed += 1
-            elif move.rule == "carried":
+            elif move.rule in ("carried", "follow"):
                 carried += 1
             else:
                 moved[category] += 1

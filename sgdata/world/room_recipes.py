@@ -24,7 +24,9 @@ class CountedClass:
 
     class_name: str
     count: tuple[int, int]  # inclusive range
-    near: str | None = None  # furniture: stand beside (and face) an instance of this class
+    # furniture: stand beside (and face) an instance of this class; None: where the class's
+    # catalog anchors say (a chair at a table, a desk or a wall), else anywhere free
+    near: str | None = None
     above: str | None = None  # wall items: hang above an instance of this class
     side: str = "any"  # with `near`: which side of the anchor (any | front | sides)
 

@@ -1,10 +1,12 @@
 """Room generator: a believable, collision-free room of a given type from a seed.
 
 Order of work, each step checked against everything placed before it:
-shell and door -> fixture runs along walls -> wall-floor and floor furniture (some beside an
-anchor, facing it) -> wall items (windows, paintings, mirrors) -> small objects on receptacle
-surfaces or inside containers. Attached parts (counter tops, shelf boards, basins, burners)
-come with their owners as objects of their own.
+shell and door -> fixture runs along walls -> wall-floor and floor furniture (beside the
+anchor its recipe names; else where its class belongs, see :mod:`sgdata.world.arrangement`:
+chairs at tables, desks or walls, footstools by the seating; only then anywhere free) -> wall
+items (windows, paintings, mirrors) -> small objects on receptacle surfaces or inside
+containers. Attached parts (counter tops, shelf boards, basins, burners) come with their
+owners as objects of their own.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ import numpy as np
 from sgdata import seeds
 from sgdata.errors import ConfigError
 from sgdata.seeds import rng_for
+from sgdata.world.arrangement import FREE, anchor_objects, draw_spot, tier_of, tiers_for
 from sgdata.world.catalog import Catalog, ClassSpec, load_catalog
 from sgdata.world.placement import (
     colliding,
@@ -262,6 +265,9 @@ class _RoomBuilder:
         return False
 
     def _place_furniture(self, spec: ClassSpec, item: CountedClass) -> None:
+        if item.near is None and spec.anchors:
+            self._place_anchored(spec)
+            return
         anchors = [o for o in self.objects if item.near and o.class_name == item.near]
         for _ in range(FLOOR_TRIES):
             size = self._size(spec)
@@ -273,6 +279,22 @@ class _RoomBuilder:
                 along = self._uniform(size[0] / 2, self.room.wall_length(wall) - size[0] / 2)
                 placement = wall_placement(self.room, wall, along, size[1], 0.0)
             else:
+                placement = self._anywhere(spec, size)
+            candidate = self._new(spec, size, placement)
+            if self._fits(candidate):
+                self._commit(candidate)
+                return
+
+    def _place_anchored(self, spec: ClassSpec) -> None:
+        """Where the class belongs: at one of its anchor objects, facing it; else back to a
+        wall; only in the last tries anywhere free (the tiers of ``arrangement.tier_of``)."""
+        anchors = anchor_objects(spec, self.objects, self.catalog, exclude=set())
+        tiers = tiers_for(spec, bool(anchors))
+        for attempt in range(FLOOR_TRIES):
+            size = self._size(spec)
+            tier = tier_of(attempt, FLOOR_TRIES, tiers)
+            placement = draw_spot(self.rng, tier, anchors, self.room, size)
+            if tier == FREE or placement is None:
                 placement = self._anywhere(spec, size)
             candidate = self._new(spec, size, placement)
             if self._fits(candidate):

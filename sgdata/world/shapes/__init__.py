@@ -20,5 +20,15 @@ from sgdata.world.shapes.base import (
     build_shape,
     merged_mesh,
 )
+from sgdata.world.shapes.uvs import box_uvs
 
-__all__ = ["RECIPES", "Attachment", "Part", "ShapeBuild", "Surface", "build_shape", "merged_mesh"]
+__all__ = [
+    "RECIPES",
+    "Attachment",
+    "Part",
+    "ShapeBuild",
+    "Surface",
+    "box_uvs",
+    "build_shape",
+    "merged_mesh",
+]

@@ -12,12 +12,14 @@ from sgdata.world.shapes.base import (
     DARK,
     METAL,
     Color,
+    Part,
     ShapeBuild,
     Size,
     Surface,
     box,
     cone,
     cylinder,
+    elliptic_cylinder,
     frustum,
     hollow_box,
     open_cylinder,
@@ -322,4 +324,109 @@ def monitor(size: Size, variant: int, color: Color) -> ShapeBuild:
             (0.75, 0.75, 0.75),
         )
     )
+    return ShapeBuild(parts=parts)
+
+
+@recipe("shoes")
+def shoes(size: Size, variant: int, color: Color) -> ShapeBuild:
+    """A pair of shoes side by side, toes to the front (-Y), on dark soles: variant 0 laced
+    shoes with a rounded toe cap and a tongue, variant 1 slippers open at the heel."""
+    w, d, h = size
+    sw = w * 0.44  # one shoe's width
+    sole = min(0.02, h * 0.2)
+    toe = min(sw / 2, d * 0.3)
+    parts: list[Part] = []
+    for sx in (-1.0, 1.0):
+        x = sx * w / 4
+        parts.append(slab((x - sw / 2, -d / 2, 0.0), (x + sw / 2, d / 2, sole), DARK))
+        cap = (h - sole) * (0.6 if variant % 2 == 0 else 0.8)
+        parts.append(
+            elliptic_cylinder(sw * 0.45, toe, cap, (x, -d / 2 + toe, sole + cap / 2), color)
+        )
+        if variant % 2 == 0:
+            parts.append(
+                slab((x - sw * 0.45, -d / 2 + toe, sole), (x + sw * 0.45, d / 2, h), color)
+            )
+            parts.append(
+                slab(
+                    (x - sw * 0.15, -d / 2 + toe * 0.8, sole + cap * 0.8),
+                    (x + sw * 0.15, -d / 2 + toe + d * 0.2, h),
+                    shade(color, 1.3),
+                )
+            )
+        else:
+            parts.append(
+                slab(
+                    (x - sw * 0.45, -d / 2 + toe, sole), (x + sw * 0.45, d * 0.1, sole + cap), color
+                )
+            )
+    return ShapeBuild(parts=parts)
+
+
+@recipe("picture_frame")
+def picture_frame(size: Size, variant: int, color: Color) -> ShapeBuild:
+    """A standing photo frame facing the front (-Y), propped up by a stand behind it: variant
+    0 holds a landscape (sky over green), variant 1 a portrait (a face on grey)."""
+    w, d, h = size
+    t = min(0.015, d * 0.3)  # frame thickness
+    f = min(0.02, w * 0.12, h * 0.12)  # border width
+    y0 = -d / 2
+    parts = [
+        slab((-w / 2, y0, 0.0), (w / 2, y0 + t, f), color),
+        slab((-w / 2, y0, h - f), (w / 2, y0 + t, h), color),
+        slab((-w / 2, y0, f), (-w / 2 + f, y0 + t, h - f), color),
+        slab((w / 2 - f, y0, f), (w / 2, y0 + t, h - f), color),
+    ]
+    px0, px1, pz0, pz1 = -w / 2 + f, w / 2 - f, f, h - f
+    py0 = y0 + t * 0.4  # the photo is recessed behind the border's front
+    if variant % 2 == 0:
+        mid = pz0 + (pz1 - pz0) * 0.45
+        parts += [
+            slab((px0, py0, mid), (px1, y0 + t, pz1), (0.55, 0.75, 0.92)),
+            slab((px0, py0, pz0), (px1, y0 + t, mid), (0.3, 0.55, 0.25)),
+        ]
+    else:
+        r = min(px1 - px0, pz1 - pz0) * 0.25
+        parts += [
+            slab((px0, py0, pz0), (px1, y0 + t, pz1), (0.6, 0.6, 0.62)),
+            cylinder(
+                r,
+                t * 0.3,
+                (0.0, py0 - t * 0.15, pz0 + (pz1 - pz0) * 0.6),
+                (0.85, 0.68, 0.55),
+                axis="y",
+                sections=14,
+            ),
+        ]
+    # the stand: a strut from the back of the frame to a foot resting on the surface behind it
+    sw = min(0.03, w * 0.2)
+    parts += [
+        slab((-sw / 2, y0 + t, h * 0.3), (sw / 2, d / 2, h * 0.3 + 0.006), shade(color, 0.8)),
+        slab((-sw / 2, d / 2 - 0.006, 0.0), (sw / 2, d / 2, h * 0.3 + 0.006), shade(color, 0.8)),
+    ]
+    return ShapeBuild(parts=parts)
+
+
+@recipe("backpack")
+def backpack(size: Size, variant: int, color: Color) -> ShapeBuild:
+    """A backpack standing upright, straps at the back (+Y): a rounded body, a front pocket
+    and a carry loop on top."""
+    w, d, h = size
+    loop = min(0.04, h * 0.1)
+    hb = h - loop  # the body's height
+    body_d = d * 0.7
+    cy = d / 2 - body_d / 2
+    parts = [
+        elliptic_cylinder(w / 2, body_d / 2, hb * 0.85, (0.0, cy, hb * 0.425), color),
+        sphere(0.5, (0.0, cy, hb * 0.85), color, scale=(w, body_d, hb * 0.3), subdivisions=1),
+        slab((-w * 0.35, -d / 2, hb * 0.1), (w * 0.35, cy, hb * 0.5), shade(color, 0.85)),
+        slab((-0.03, cy - 0.008, hb - 0.01), (0.03, cy + 0.008, h), shade(color, 0.6)),
+    ]
+    for sx in (-1.0, 1.0):
+        x = sx * w * 0.25
+        parts.append(
+            slab(
+                (x - 0.02, d / 2 - 0.015, hb * 0.1), (x + 0.02, d / 2, hb * 0.8), shade(color, 0.6)
+            )
+        )
     return ShapeBuild(parts=parts)

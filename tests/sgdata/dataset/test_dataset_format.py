@@ -392,6 +392,7 @@ def _fake_migration(raw: dict) -> dict:
 def test_older_minor_is_migrated_through_the_hook(monkeypatch: pytest.MonkeyPatch) -> None:
     data = json.loads(make_manifest().to_json())
     data["title"] = data.pop("name")
+    data["format_version"] = "1.0.0"  # an older minor than the reader's
     out = migrate_manifest_dict(data, current="1.1.0", migrations={"1.0.0": _fake_migration})
     assert out["name"] == "tiny" and out["format_version"] == "1.1.0" and "title" not in out
     # and through the registry, as the reader does it

@@ -292,3 +292,44 @@ def test_manifest_tier_counts_checked(copy: Path) -> None:
 
     edit_manifest(copy, shift)
     assert "counts.tiers" in checks(validate_dataset(copy, quick=True))
+
+
+# ------------------------------------------------------------------ appearance (format 1.1)
+
+
+def test_appearance_out_of_its_ranges(copy: Path) -> None:
+    rows, schema = rows_of(copy, SHARD)
+    rows[3]["light_intensity"] = 3.0  # the config draws [0.8, 1.2]
+    rows[5]["light_temperature"] = None
+    rows[6]["textures"] = None
+    rewrite(copy, SHARD, pa.Table.from_pylist(rows, schema=schema))
+    report = validate_dataset(copy, quick=True)
+    problems = {(p.row, p.field) for p in find(report, "rows.appearance")}
+    assert problems == {(3, "light_intensity"), (5, "light_temperature"), (6, "textures")}
+    messages = {p.field: p.message for p in find(report, "rows.appearance")}
+    assert "3.0: outside the configured [0.8, 1.2]" in messages["light_intensity"]
+    assert checks(report) == {"rows.appearance"}
+
+
+def test_a_format_1_0_dataset_without_appearance_columns_still_reads(copy: Path) -> None:
+    from sgdata.dataset import Dataset
+
+    added = ["textures", "light_intensity", "light_temperature"]
+    raw = json.loads((copy / "dataset.json").read_text())
+    for entry in raw["files"]:
+        if entry["path"].startswith("observations/"):
+            rewrite(copy, entry["path"], pq.read_table(copy / entry["path"]).drop_columns(added))
+
+    def as_1_0(raw: dict) -> None:
+        raw["format_version"] = "1.0.0"
+        del raw["config"]["appearance"]
+
+    edit_manifest(copy, as_1_0)
+    report = validate_dataset(copy, quick=True)
+    assert report.ok, report.problems[:3]
+    views = Dataset.open(copy).observations("train", columns=["obs_id", *added])
+    assert views.column("light_intensity").null_count == views.num_rows
+    # a 1.1 dataset lacking them is reported
+    edit_manifest(copy, lambda raw: raw.update(format_version="1.1.0"))
+    report = validate_dataset(copy, quick=True)
+    assert {p.field for p in find(report, "tables.schema")} == set(added)

@@ -174,6 +174,10 @@ def _broken(tmp_path: Path, name: str, old: str, new: str) -> Path:
         ("Bowl", r"palette = \[", 'palette = ["red", ', "palette"),
         ("Cup", r'receptacles = \["CounterTop"', 'receptacles = ["Countertop"', "receptacles"),
         ("Window", r"wall_height = \[[^\]]*\]", "wall_height = [1.5, 1.0]", "wall_height"),
+        ("Chair", r"anchors = \[[^\]]*\]", 'anchors = ["DinnerTable", "wall"]', "anchors"),
+        ("Chair", r"anchors = \[[^\]]*\]", 'anchors = ["Mug"]', "anchors"),
+        ("Mug", r'placement = "surface"', 'placement = "surface"\nanchors = ["wall"]', "anchors"),
+        ("Bed", r"anchor_sides = \[[^\]]*\]", 'anchor_sides = ["top"]', "anchor_sides"),
     ],
 )
 def test_broken_entry_names_class_and_field(
@@ -195,3 +199,15 @@ def test_missing_file_raises(tmp_path: Path) -> None:
 def test_palettes_are_in_range() -> None:
     colours = np.array([c for spec in CATALOG.classes.values() for c in spec.palette])
     assert colours.min() >= 0.0 and colours.max() <= 1.0
+
+
+def test_floor_classes_know_where_they_belong() -> None:
+    assert CATALOG["Chair"].anchors == ("DiningTable", "Desk", "wall")
+    assert {"ArmChair", "Sofa", "Bed"} <= set(CATALOG["Ottoman"].anchors)
+    assert CATALOG["DiningTable"].sides_to_stand_at() == ("front", "right", "back", "left")
+    assert CATALOG["Desk"].sides_to_stand_at() == ("front",)  # it stands against a wall
+    assert CATALOG["ArmChair"].sides_to_stand_at() == ("front",)
+    assert CATALOG["Mug"].sides_to_stand_at() == ()
+    for spec in CATALOG.classes.values():
+        if spec.anchors:
+            assert spec.placement == "floor", spec.name

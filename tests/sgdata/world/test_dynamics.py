@@ -140,8 +140,15 @@ def test_layer_edited_into_a_wall_is_refused(
     copy = tmp_path / "kitchen_000"
     shutil.copytree(kitchen_dir, copy)
     room = read_room(copy / "room.usda")
-    chair = next(o for o in room.objects if o.class_name == "Chair")
     text = layout_file(copy, 2).read_text()
+    # an object on the floor (a chair when one stays put) that the layer does not override
+    # already, so ours is the one read
+    free = [
+        o
+        for o in room.objects
+        if o.support is None and o.attached_to is None and f'over "{o.prim_name}"' not in text
+    ]
+    chair = min(free, key=lambda o: (o.class_name != "Chair", o.instance))
     # author a translate for the chair that puts it half through the west wall
     override = (
         f'    over "{chair.prim_name}"\n    {{\n'
@@ -150,7 +157,6 @@ def test_layer_edited_into_a_wall_is_refused(
     anchor = 'over "Objects"\n    {\n'
     assert anchor in text
     text = text.replace(anchor, anchor + override, 1)
-    # drop an earlier override of the same prim so ours is the one read
     layout_file(copy, 2).write_text(text)
     with pytest.raises(SceneError, match=chair.prim_name):
         load_layout(copy, 2, catalog)
