@@ -75,6 +75,7 @@ def main() -> None:
         print(f"{part:<18} {float((after - before).norm() / before.norm()):>16.2e}")
     model.eval()
     a, _, _, _ = next(iter(DataLoader(data, batch_size=16, collate_fn=collate_triplets)))
+    a = a.prepare()  # float images and a dense adjacency, as SeanNet.embed sees them
     with torch.no_grad():
         c4 = model.backbone(a.images)
         c5 = model.head[0](c4)

@@ -62,8 +62,9 @@ class ImageEncoder(nn.Module):
         return self.project(self.encoder(images))
 
     def embed(self, batch: SceneBatch) -> Tensor:
-        """Scene embeddings of a batch's images (its scene graphs are ignored)."""
-        return self(batch.images)
+        """Scene embeddings of a batch's images (its scene graphs are ignored; uint8 images are
+        normalised where they are, :meth:`SceneBatch.normalised_images`)."""
+        return self(batch.normalised_images())
 
     def extra_repr(self) -> str:
         return f"name={self.name!r}, native_dim={self.native_dim}, embed_dim={self.embed_dim}"

@@ -6,13 +6,18 @@ The reader side of the on-disk format (docs/dataset.md) for training and evaluat
 - :func:`graph_tensors` turns one row's ``objects`` and ``relations`` into slot, class, box and
   row-normalised adjacency tensors (DESIGN §8).
 - :class:`TripletDataset` (training) and :class:`ObservationDataset` (evaluation) yield those
-  tensors per view; :func:`collate_triplets` and :func:`collate_views` batch them into
-  :class:`~seannet.batch.SceneBatch` objects for ``torch.utils.data.DataLoader``.
+  tensors per view, and whole batches of views gathered at once (``__getitems__``, what
+  ``torch.utils.data.DataLoader`` asks for); :func:`collate_triplets` and
+  :func:`collate_views` (:mod:`seannet.collate`) batch them into
+  :class:`~seannet.batch.SceneBatch` objects in the compact form: uint8 pixels and sparse
+  adjacency, normalised and densified by the model on its own device.
 - :func:`dataset_identity` names the data a model was trained on, for checkpoints.
 
 With ``cache=True`` (or a cache directory) the datasets read images from the decoded-image
 cache of :mod:`seannet.image_cache` (built on first use, rebuilt when stale) instead of
-decoding PNG per view; the tensors are the same either way.
+decoding PNG per view; the tensors are the same either way. Reading a batch from the cache
+is one copy of its pixels out of the memory map plus a few vectorised takes of the split's
+graph arrays (built once per process).
 
 Files are opened lazily in each process that reads (``DataLoader`` workers included): a
 dataset object holds only plain Python and numpy state until its first item is read, and the
@@ -24,26 +29,34 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import sys
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
-import torch
 from torch import Tensor
 from torch.utils.data import Dataset as TorchDataset
 
-from seannet.batch import NUM_RELATIONS, SceneBatch
+from seannet.collate import (
+    ObservationItem,
+    ObservationItems,
+    TripletItem,
+    TripletItems,
+    ViewArrays,
+    ViewTensors,
+    collate_triplets,
+    collate_views,
+)
 from seannet.errors import DataError
 from seannet.image_cache import CachedImages, open_image_cache
 from seannet.view_inputs import (
     IMAGENET_MEAN,
     IMAGENET_STD,
     ImageTransform,
-    dense_adjacency,
     graph_from_columns,
     graph_tensors,
     struct_columns,
@@ -57,8 +70,10 @@ __all__ = [
     "ImageTransform",
     "ObservationDataset",
     "ObservationItem",
+    "ObservationItems",
     "TripletDataset",
     "TripletItem",
+    "TripletItems",
     "ViewTensors",
     "collate_triplets",
     "collate_views",
@@ -119,64 +134,6 @@ def _one_line(text: str) -> str:
     return " ".join(text.split())
 
 
-@dataclass
-class ViewTensors:
-    """One view ready for the model (see :class:`~seannet.batch.SceneBatch` for the meaning).
-
-    Attributes:
-        image: (3, S, S) float32, normalised.
-        boxes: (K, 4) float32 pixel boxes in the S x S frame.
-        class_ids: (K,) long.
-        slots: (K,) long.
-        edge_index: (3, E) long, [relation, src slot, dst slot] of each non-zero adjacency
-            cell (relation 0 on, 1 in, 2 proximity).
-        edge_weight: (E,) float32, the row-normalised value of each cell.
-        num_slots: M.
-
-    The adjacency travels sparse (a dense one is 3 x M x M floats, 786 KB at M = 256) and is
-    made dense once per batch by the collate functions; :attr:`adjacency` gives it per view.
-    """
-
-    image: Tensor
-    boxes: Tensor
-    class_ids: Tensor
-    slots: Tensor
-    edge_index: Tensor
-    edge_weight: Tensor
-    num_slots: int
-
-    @property
-    def adjacency(self) -> Tensor:
-        """(3, M, M) float32, row-normalised on / in / proximity (absent nodes: zero rows)."""
-        return dense_adjacency(self.edge_index, self.edge_weight, self.num_slots)
-
-
-@dataclass
-class TripletItem:
-    """One training triplet: three views of one room, its cascade tier and its ids."""
-
-    anchor: ViewTensors
-    positive: ViewTensors
-    negative: ViewTensors
-    tier: int  # cascade tier 0..4
-    triplet_id: int  # row of triplets/<split>.parquet
-    room_id: str
-    ids: tuple[str, str, str]  # obs ids of anchor, positive, negative
-
-
-@dataclass
-class ObservationItem:
-    """One view of a split with its pose metadata (nullable fields are None for real photos)."""
-
-    view: ViewTensors
-    obs_id: str
-    room_id: str
-    layout: int
-    grid_i: int | None
-    grid_j: int | None
-    heading: int | None
-
-
 # ---------------------------------------------------------------------------------- storage
 
 
@@ -185,9 +142,7 @@ class _Shard:
 
     Images stay encoded (PNG/JPEG bytes in the Arrow column) and are decoded on access, or
     are not read at all (``with_images=False``, when the image cache serves them); the scene
-    graphs are flattened once into numpy columns with per-row offsets, and each row's graph
-    tensors are kept once computed (``graphs``: a few KB a view, the largest per-view cost
-    after PNG decoding).
+    graphs are flattened into numpy columns with per-row offsets.
     """
 
     def __init__(self, path: Path, *, with_images: bool = True) -> None:
@@ -208,28 +163,24 @@ class _Shard:
             obj["box2d"],
         )
         self.src, self.dst, self.type = rel["src"], rel["dst"], rel["type"]
-        self.graphs: list[tuple[Tensor, ...] | None] = [None] * (len(self.obj_offsets) - 1)
+
+    def __len__(self) -> int:
+        return len(self.obj_offsets) - 1
 
     def graph(self, row: int, num_slots: int) -> tuple[Tensor, ...]:
-        """Row ``row``'s :func:`graph_from_columns` tensors, computed on first use.
-
-        Callers must not modify them in place (:meth:`_ViewStore.view` hands out copies).
-        """
-        graph = self.graphs[row]
-        if graph is None:
-            o0, o1 = self.obj_offsets[row], self.obj_offsets[row + 1]
-            r0, r1 = self.rel_offsets[row], self.rel_offsets[row + 1]
-            graph = self.graphs[row] = graph_from_columns(
-                self.instance[o0:o1],
-                self.class_id[o0:o1],
-                self.slot[o0:o1],
-                self.box2d[o0:o1],
-                self.src[r0:r1],
-                self.dst[r0:r1],
-                self.type[r0:r1],
-                num_slots,
-            )
-        return graph
+        """Row ``row``'s :func:`graph_from_columns` tensors."""
+        o0, o1 = self.obj_offsets[row], self.obj_offsets[row + 1]
+        r0, r1 = self.rel_offsets[row], self.rel_offsets[row + 1]
+        return graph_from_columns(
+            self.instance[o0:o1],
+            self.class_id[o0:o1],
+            self.slot[o0:o1],
+            self.box2d[o0:o1],
+            self.src[r0:r1],
+            self.dst[r0:r1],
+            self.type[r0:r1],
+            num_slots,
+        )
 
 
 def _flatten_lists(
@@ -242,11 +193,99 @@ def _flatten_lists(
     return offsets - offsets[0], values
 
 
+@dataclass
+class _SplitGraphs:
+    """Every view's graph tensors of one split, concatenated in storage order (numpy).
+
+    View v's objects are rows ``box_offsets[v]:[v + 1]`` of ``slots``, ``class_ids`` and
+    ``boxes``; its adjacency cells columns ``edge_offsets[v]:[v + 1]`` of ``edges`` (3, E)
+    [relation, row slot, column slot] and ``edge_weight`` (E,). A batch is gathered from
+    them with a few vectorised takes (:meth:`_ViewStore.gather`), whatever its size.
+    """
+
+    box_offsets: np.ndarray
+    slots: np.ndarray
+    class_ids: np.ndarray
+    boxes: np.ndarray  # (K, 4) float32: in the cached S x S frame with the cache, else as stored
+    edge_offsets: np.ndarray
+    edges: np.ndarray
+    edge_weight: np.ndarray
+
+    spans: np.ndarray = field(init=False)  # (N, 4): first object, objects, first cell, cells
+
+    def __post_init__(self) -> None:
+        b, e = self.box_offsets, self.edge_offsets
+        self.spans = np.stack((b[:-1], np.diff(b), e[:-1], np.diff(e)), axis=1)
+
+
+def _offsets(counts: Sequence[int]) -> np.ndarray:
+    return np.concatenate(([0], np.cumsum(np.asarray(counts, dtype=np.int64))))
+
+
+def _spans(
+    spans: np.ndarray, rows: np.ndarray, local: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, list[np.ndarray], list[np.ndarray]]:
+    """The objects and the adjacency cells of views ``rows``, concatenated in row order.
+
+    Args:
+        spans: (N, 4) int64 per view: first object, object count, first cell, cell count.
+        rows: (n,) the views.
+        local: (n,) each row's view index within its batch.
+
+    Returns:
+        ``(box_offsets, edge_offsets, [object index, cell index], [object view, cell view])``:
+        (n + 1,) offsets of each row's range in the concatenation, the (K,) and (E,) indices
+        into the split's arrays, and the ``local`` view of each.
+    """
+    sp = spans[rows]
+    out = np.zeros((len(rows) + 1, 2), dtype=np.int64)
+    np.cumsum(sp[:, 1::2], axis=0, out=out[1:])
+    index, owner = [], []
+    for k in (0, 1):
+        starts, counts = sp[:, 2 * k], sp[:, 2 * k + 1]
+        index.append(np.arange(out[-1, k]) + (starts - out[:-1, k]).repeat(counts))
+        owner.append(local.repeat(counts))
+    return out[:, 0], out[:, 1], index, owner
+
+
+class _PixelBuffers:
+    """Reused (n, S, S, 3) uint8 arrays to gather batches of pixels into, in one process.
+
+    A fresh array of a few MB comes from the kernel a page at a time: glibc maps it, or grows
+    its heap and trims it again once the batch is freed, so every batch pays a page fault per
+    4 KB (measured: ~400 faults and ~1 ms a 224 px batch of 8 triplets, more than copying the
+    pixels in). A kept array is handed out again only when nothing else refers to it any more
+    (every tensor made from it is gone): its reference count is back to its idle value, the
+    count with only this object holding it. At most :attr:`KEEP` arrays are kept.
+    """
+
+    KEEP = 4  # arrays kept: a training loop holds one or two batches while the next is read
+
+    def __init__(self) -> None:
+        self._arrays: list[np.ndarray] = [np.empty(0, dtype=np.uint8)]
+        # the same expression as in take(): the list's reference and the call's argument
+        self._idle = sys.getrefcount(self._arrays[0])
+        self._arrays.clear()
+
+    def take(self, shape: tuple[int, ...]) -> np.ndarray:
+        """An uninitialised uint8 array of ``shape`` that nobody else uses."""
+        for k in reversed(range(len(self._arrays))):  # the most recently used first: cache-warm
+            if self._arrays[k].shape == shape and sys.getrefcount(self._arrays[k]) == self._idle:
+                self._arrays.append(self._arrays.pop(k))  # most recently used last
+                return self._arrays[-1]
+        self._arrays.append(np.empty(shape, dtype=np.uint8))
+        if len(self._arrays) > self.KEEP:
+            del self._arrays[0]  # forgotten, not freed while in use
+        return self._arrays[-1]
+
+
 class _ViewStore:
-    """Per-process access to the views of one split: obs index, lazy shards, transform.
+    """Per-process access to the views of one split: obs index, lazy shards and graphs.
 
     Holds only plain state when pickled or forked; shards are read in the process that asks
-    for a view (``os.getpid()`` keys the cache, so a fork never reuses the parent's).
+    for a view (``os.getpid()`` keys the cache, so a fork never reuses the parent's). The first
+    read in a process reads the split's graph columns and builds every view's graph tensors
+    once (:class:`_SplitGraphs`; ``medium``'s 8,013 train views: 1.5-2 s here).
     """
 
     def __init__(
@@ -266,15 +305,17 @@ class _ViewStore:
         rows = [pq.read_metadata(p).num_rows for p in self.files]
         if sum(rows) != len(self.obs_ids):
             raise DataError(f"split {split!r}: observation shards changed while being read")
-        self.file_starts = np.concatenate(([0], np.cumsum(rows))).astype(np.int64)
-        self.locations: list[tuple[int, int]] = [
-            (f, r) for f, n in enumerate(rows) for r in range(n)
-        ]
-        self.index = dict(zip(self.obs_ids, self.locations, strict=True))
+        self.file_starts = _offsets(rows)
+        self.index = {obs: v for v, obs in enumerate(self.obs_ids)}
         if len(self.index) != len(self.obs_ids):
             raise DataError(f"split {split!r}: an obs_id repeats across its observation shards")
         self._pid: int | None = None
         self._shards: dict[int, _Shard] = {}
+        self._graphs: _SplitGraphs | None = None
+        self._buffers = _PixelBuffers()
+        self._local: dict[tuple[int, int], np.ndarray] = {}  # (n, block): view within batch
+        self.mean: tuple[float, float, float] = tuple(transform.mean)  # type: ignore[assignment]
+        self.std: tuple[float, float, float] = tuple(transform.std)  # type: ignore[assignment]
         self.cached = images
         if images is not None and images.obs_ids != self.obs_ids:
             raise DataError(
@@ -284,10 +325,15 @@ class _ViewStore:
 
     def __getstate__(self) -> dict[str, Any]:
         state = dict(self.__dict__)
-        state["_pid"], state["_shards"] = None, {}
+        state["_pid"], state["_shards"], state["_graphs"] = None, {}, None
+        state["_buffers"] = _PixelBuffers()
         return state
 
-    def locate(self, obs_id: str) -> tuple[int, int]:
+    def __len__(self) -> int:
+        return len(self.obs_ids)
+
+    def locate(self, obs_id: str) -> int:
+        """The view's row in storage order."""
         try:
             return self.index[obs_id]
         except KeyError:
@@ -295,43 +341,103 @@ class _ViewStore:
                 f"observation {obs_id!r} is not in split {self.split!r}'s observation shards"
             ) from None
 
-    def shard(self, f: int) -> _Shard:
+    def _own(self) -> None:
         pid = os.getpid()
         if self._pid != pid:  # first access in this process (a fresh DataLoader worker)
-            self._pid, self._shards = pid, {}
+            self._pid, self._shards, self._graphs = pid, {}, None
+            self._buffers = _PixelBuffers()
+
+    def shard(self, f: int) -> _Shard:
+        self._own()
         shard = self._shards.get(f)
         if shard is None:
             shard = self._shards[f] = _Shard(Path(self.files[f]), with_images=self.cached is None)
         return shard
 
-    def view(self, f: int, row: int) -> ViewTensors:
-        s = self.shard(f)
-        obs = self.obs_ids_of(f, row)
-        try:
-            slots, class_ids, boxes, edge_index, edge_weight = s.graph(row, self.num_slots)
-            if self.cached is None:
-                rgb, box = decode_image(s.images[row].as_py()), boxes.numpy()  # type: ignore[index]
-            else:
-                at = int(self.file_starts[f]) + row
-                h, w = self.cached.source_hw[at]
-                rgb, box = self.cached.image(at), self._scaled_boxes(int(h), int(w), boxes.numpy())
-        except (DataError, DatasetError) as exc:
-            raise DataError(f"observation {obs!r}: {exc}") from None
-        image, boxes = self.transform(rgb, box)  # new boxes: the kept ones stay untouched
-        kept = (class_ids, slots, edge_index, edge_weight)
-        class_ids, slots, edge_index, edge_weight = (t.clone() for t in kept)
-        return ViewTensors(image, boxes, class_ids, slots, edge_index, edge_weight, self.num_slots)
+    def graphs(self) -> _SplitGraphs:
+        """The split's graph tensors, built on first use in this process."""
+        self._own()
+        if self._graphs is None:
+            self._graphs = self._build_graphs()
+        return self._graphs
 
-    def _scaled_boxes(self, h: int, w: int, boxes: np.ndarray) -> np.ndarray:
-        """Boxes of a cached view scaled from its decoded h x w frame to the cached one, with
-        ImageTransform's factors and float32 arithmetic (the transform then leaves a view
-        already at its size, and its boxes, as they are)."""
+    def _build_graphs(self) -> _SplitGraphs:
+        parts: list[tuple[Tensor, ...]] = []
+        for f in range(len(self.files)):
+            shard = self.shard(f)
+            if len(shard) != self.file_starts[f + 1] - self.file_starts[f]:
+                raise DataError(f"{self.files[f]}: changed while being read; open it again")
+            for row in range(len(shard)):
+                try:
+                    parts.append(shard.graph(row, self.num_slots))
+                except DataError as exc:
+                    obs = self.obs_ids[int(self.file_starts[f]) + row]
+                    raise DataError(f"observation {obs!r}: {exc}") from None
+        slots, class_ids, boxes, edges, weights = ([p[k].numpy() for p in parts] for k in range(5))
+        box_offsets = _offsets([len(x) for x in slots])
+        boxes_all = np.concatenate(boxes).reshape(-1, 4) if parts else np.zeros((0, 4))
+        boxes_all = boxes_all.astype(np.float32, copy=False)
+        if self.cached is not None:  # into the cached frame, once
+            hw = np.repeat(self.cached.source_hw, np.diff(box_offsets), axis=0)
+            boxes_all = self.transform.scale_boxes(boxes_all, hw)
+        return _SplitGraphs(
+            box_offsets=box_offsets,
+            slots=np.concatenate(slots) if parts else np.zeros(0, np.int64),
+            class_ids=np.concatenate(class_ids) if parts else np.zeros(0, np.int64),
+            boxes=boxes_all,
+            edge_offsets=_offsets([x.shape[0] for x in weights]),
+            edges=np.concatenate(edges, axis=1) if parts else np.zeros((3, 0), np.int64),
+            edge_weight=np.concatenate(weights) if parts else np.zeros(0, np.float32),
+        )
+
+    def gather(self, rows: np.ndarray, block: int) -> ViewArrays:
+        """Views ``rows`` (storage order) as one :class:`ViewArrays` in blocks of ``block``,
+        pixels copied once."""
+        g = self.graphs()
+        local = self._local.get((len(rows), block))
+        if local is None:
+            local = self._local[len(rows), block] = np.arange(len(rows)) % block
+        box_offsets, edge_offsets, (at, cells), (box_view, edge_view) = _spans(g.spans, rows, local)
+        edges = np.empty((4, len(cells)), dtype=np.int64)
+        edges[0] = edge_view
+        np.take(g.edges, cells, axis=1, out=edges[1:], mode="clip")
+        boxes = g.boxes[at]
         s = self.transform.size
-        scale = np.asarray([s / w, s / h, s / w, s / h], dtype=np.float32)
-        return np.asarray(boxes, dtype=np.float32).reshape(-1, 4) * scale
+        pixels = self._buffers.take((len(rows), s, s, 3))
+        if self.cached is not None:
+            # rows are in range; "clip" skips the buffered copy "raise" makes with ``out``
+            np.take(self.cached.array, rows, axis=0, out=pixels, mode="clip")
+        else:
+            hw = np.empty((len(rows), 2), dtype=np.int64)
+            for k, v in enumerate(rows.tolist()):
+                f = int(np.searchsorted(self.file_starts, v, side="right")) - 1
+                images = self.shard(f).images
+                try:
+                    rgb = decode_image(images[v - int(self.file_starts[f])].as_py())  # type: ignore[index]
+                except (DataError, DatasetError) as exc:
+                    raise DataError(f"observation {self.obs_ids[v]!r}: {exc}") from None
+                hw[k] = rgb.shape[:2]
+                pixels[k], _ = self.transform.resize(rgb, _NO_BOXES)
+            boxes = self.transform.scale_boxes(boxes, np.repeat(hw, np.diff(box_offsets), axis=0))
+        return ViewArrays(
+            pixels=pixels,
+            boxes=boxes,
+            class_ids=g.class_ids[at],
+            slots=g.slots[at],
+            box_view=box_view,
+            box_offsets=box_offsets,
+            edges=edges,
+            edge_weight=g.edge_weight[cells],
+            edge_offsets=edge_offsets,
+            num_slots=self.num_slots,
+            mean=self.mean,
+            std=self.std,
+            block=block,
+            in_range=True,
+        )
 
-    def obs_ids_of(self, f: int, row: int) -> str:
-        return self.obs_ids[int(self.file_starts[f]) + row]
+
+_NO_BOXES = np.zeros((0, 4), dtype=np.float32)
 
 
 def _call(fn: Any, *args: Any, **kwargs: Any) -> Any:
@@ -340,6 +446,11 @@ def _call(fn: Any, *args: Any, **kwargs: Any) -> Any:
         return fn(*args, **kwargs)
     except DatasetError as exc:
         raise DataError(_one_line(str(exc))) from None
+
+
+def _indices(indices: Sequence[int]) -> np.ndarray:
+    """Item indices as an int64 array (numpy's indexing then checks their range)."""
+    return np.asarray(indices, dtype=np.int64).reshape(-1)
 
 
 # ---------------------------------------------------------------------------------- datasets
@@ -371,12 +482,15 @@ class TripletDataset(TorchDataset):
 
     Construction reads only the triplet table and the ``obs_id`` column of the split's
     observation shards (to index every view by id, and to check every triplet's views
-    exist). Each process that reads items (the main one, or each ``DataLoader`` worker) loads
-    the image, objects and relations columns of a room shard on its first view from it and
-    keeps them (images still encoded) for later items; images are decoded per item, or read
-    from the memory-mapped image cache with ``cache``. Memory per reading process is therefore
-    about the size of the split's observation files (plus the cache pages it touches, shared
-    between processes through the page cache).
+    exist). Each process that reads items (the main one, or each ``DataLoader`` worker) reads
+    the objects and relations columns of every shard on its first item and builds every
+    view's graph tensors once; without the cache it keeps the encoded image columns too and
+    decodes per item, with ``cache`` it reads the pixels from the memory-mapped image cache.
+    Memory per reading process is therefore about the size of the split's observation files
+    (plus the cache pages it touches, shared between processes through the page cache).
+
+    ``DataLoader`` reads a batch through :meth:`__getitems__` (its views gathered at once,
+    for :func:`collate_triplets`); ``dataset[i]`` gives one :class:`TripletItem`.
 
     Args:
         root: the dataset directory.
@@ -408,13 +522,14 @@ class TripletDataset(TorchDataset):
         names = ("anchor", "positive", "negative")
         ids = [table.column(n).to_pylist() for n in names]
         self.obs: list[tuple[str, str, str]] = list(zip(*ids, strict=True))
-        locs = []
+        rows = []
         for k, triple in enumerate(self.obs):
             try:
-                locs.append(tuple(self._store.locate(o) for o in triple))
+                rows.append([self._store.locate(o) for o in triple])
             except DataError as exc:
                 raise DataError(f"triplet {int(self.triplet_ids[k])} of {split}: {exc}") from None
-        self._locations: list[tuple[tuple[int, int], ...]] = locs
+        # (3, T): the storage rows of the anchors, positives and negatives
+        self._rows = np.asarray(rows, dtype=np.int64).reshape(-1, 3).T.copy()
 
     def __len__(self) -> int:
         return len(self.obs)
@@ -422,15 +537,23 @@ class TripletDataset(TorchDataset):
     def __getitem__(self, i: int) -> TripletItem:
         if not -len(self) <= i < len(self):
             raise IndexError(f"triplet index {i} out of range for {len(self)} triplets")
-        a, p, n = (self._store.view(f, r) for f, r in self._locations[i])
-        return TripletItem(
-            anchor=a,
-            positive=p,
-            negative=n,
-            tier=int(self.tiers[i]),
-            triplet_id=int(self.triplet_ids[i]),
-            room_id=self.room_ids[i],
-            ids=self.obs[i],
+        return self.__getitems__([i])[0]
+
+    def __getitems__(self, indices: Sequence[int]) -> TripletItems:
+        """Triplets ``indices`` read together (what ``DataLoader`` asks for per batch).
+
+        Their views are gathered into one :class:`ViewArrays` (pixels copied once), which
+        :func:`collate_triplets` turns into the three batches without another copy.
+        """
+        idx = _indices(indices)
+        rows = self._rows[:, idx].reshape(-1)  # IndexError for an index out of range
+        at = idx.tolist()
+        return TripletItems(
+            self._store.gather(rows, len(idx)),
+            tiers=self.tiers[idx],
+            triplet_ids=self.triplet_ids[idx],
+            room_ids=[self.room_ids[i] for i in at],
+            ids=[self.obs[i] for i in at],
         )
 
 
@@ -472,95 +595,16 @@ class ObservationDataset(TorchDataset):
     def __getitem__(self, i: int) -> ObservationItem:
         if not -len(self) <= i < len(self):
             raise IndexError(f"observation index {i} out of range for {len(self)} views")
-        i = i % len(self)
-        f, r = self._store.locations[i]
+        return self.__getitems__([i])[0]
+
+    def __getitems__(self, indices: Sequence[int]) -> ObservationItems:
+        """Views ``indices`` read together, gathered as for :meth:`TripletDataset.__getitems__`."""
+        idx, n = _indices(indices), len(self)
+        if idx.size and (idx.min() < -n or idx.max() >= n):
+            raise IndexError(f"observation indices {indices} out of range for {n} views")
+        rows = idx % n
+        at = rows.tolist()
         m = self._store.meta
-        return ObservationItem(
-            view=self._store.view(f, r),
-            obs_id=self._store.obs_ids[i],
-            room_id=m["room_id"][i],
-            layout=int(m["layout"][i]),
-            grid_i=m["grid_i"][i],
-            grid_j=m["grid_j"][i],
-            heading=m["heading"][i],
-        )
-
-
-# ---------------------------------------------------------------------------------- collation
-
-
-def _scene_batch(views: Sequence[ViewTensors]) -> SceneBatch:
-    """Stack images and adjacency; concatenate boxes with the view index of each."""
-    counts = torch.tensor([v.boxes.shape[0] for v in views], dtype=torch.long)
-    m = views[0].num_slots
-    if any(v.num_slots != m for v in views):
-        raise DataError(f"views with {sorted({v.num_slots for v in views})} slots in one batch")
-    adjacency = torch.zeros((len(views), NUM_RELATIONS, m, m), dtype=torch.float32)
-    edges = torch.cat([v.edge_index for v in views], dim=1)
-    edge_view = torch.repeat_interleave(
-        torch.arange(len(views)), torch.tensor([v.edge_index.shape[1] for v in views])
-    )
-    adjacency[edge_view, edges[0], edges[1], edges[2]] = torch.cat([v.edge_weight for v in views])
-    return SceneBatch(
-        images=torch.stack([v.image for v in views]),
-        boxes=torch.cat([v.boxes.reshape(-1, 4) for v in views]),
-        box_view=torch.repeat_interleave(torch.arange(len(views)), counts),
-        class_ids=torch.cat([v.class_ids for v in views]),
-        slots=torch.cat([v.slots for v in views]),
-        adjacency=adjacency,
-    )
-
-
-def collate_triplets(
-    items: Sequence[TripletItem],
-) -> tuple[SceneBatch, SceneBatch, SceneBatch, dict[str, Any]]:
-    """Batch triplets as ``(anchors, positives, negatives, meta)`` (the ``collate_fn``).
-
-    Row b of each of the three batches is triplet b. ``meta`` holds ``tier`` and
-    ``triplet_id`` ((B,) long tensors), ``room_id`` and ``anchor`` / ``positive`` /
-    ``negative`` obs ids (lists of str).
-    """
-    if not items:
-        raise DataError("collate_triplets: no items; expected at least one triplet")
-    meta: dict[str, Any] = {
-        "tier": torch.tensor([t.tier for t in items], dtype=torch.long),
-        "triplet_id": torch.tensor([t.triplet_id for t in items], dtype=torch.long),
-        "room_id": [t.room_id for t in items],
-        "anchor": [t.ids[0] for t in items],
-        "positive": [t.ids[1] for t in items],
-        "negative": [t.ids[2] for t in items],
-    }
-    return (
-        _scene_batch([t.anchor for t in items]),
-        _scene_batch([t.positive for t in items]),
-        _scene_batch([t.negative for t in items]),
-        meta,
-    )
-
-
-def collate_views(
-    items: Sequence[ObservationItem | ViewTensors],
-) -> tuple[SceneBatch, dict[str, Any]]:
-    """Batch single views as ``(batch, meta)`` (the ``collate_fn`` of ObservationDataset).
-
-    ``meta`` holds ``obs_id`` and ``room_id`` (lists of str) and ``layout``, ``grid_i``,
-    ``grid_j``, ``heading`` ((B,) long tensors; -1 where the field is null, as for an unposed
-    photo). Bare :class:`ViewTensors` items give an empty ``meta``.
-    """
-    if not items:
-        raise DataError("collate_views: no items; expected at least one view")
-    if all(isinstance(x, ViewTensors) for x in items):
-        return _scene_batch(list(items)), {}
-    if not all(isinstance(x, ObservationItem) for x in items):
-        raise DataError("collate_views: items mix ObservationItem and ViewTensors")
-
-    def ints(name: str) -> Tensor:
-        values = [getattr(x, name) for x in items]
-        return torch.tensor([-1 if v is None else int(v) for v in values], dtype=torch.long)
-
-    meta: dict[str, Any] = {
-        "obs_id": [x.obs_id for x in items],
-        "room_id": [x.room_id for x in items],
-        **{name: ints(name) for name in ("layout", "grid_i", "grid_j", "heading")},
-    }
-    return _scene_batch([x.view for x in items]), meta
+        meta = {name: [m[name][i] for i in at] for name in _META_COLUMNS}
+        meta["layout"] = [int(x) for x in meta["layout"]]
+        return ObservationItems(self._store.gather(rows, len(rows)), meta)

@@ -271,7 +271,15 @@ def view_tensors(
         np.asarray(record.rel_type),
         num_slots,
     )
-    image, boxes = transform(np.asarray(record.rgb), boxes.numpy())
+    pixels, boxes = transform.resize(np.asarray(record.rgb), boxes.numpy())
     return ViewTensors(
-        image, boxes, class_t, slots, edge_index, edge_weight.to(torch.float32), num_slots
+        torch.tensor(pixels).permute(2, 0, 1),  # a copy: the record keeps its own pixels
+        boxes,
+        class_t,
+        slots,
+        edge_index,
+        edge_weight.to(torch.float32),
+        num_slots,
+        mean=tuple(transform.mean),
+        std=tuple(transform.std),
     )

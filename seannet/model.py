@@ -200,6 +200,10 @@ class SeanNet(nn.Module):
     def embed(self, batch: SceneBatch) -> Tensor:
         """Scene embeddings (B, embed_dim) of a batch.
 
+        A compact batch (the loaders') is prepared first (:meth:`SceneBatch.prepare`: images
+        normalised, adjacency made dense) where it is, so on the model's device after
+        ``batch.to(device)``.
+
         Raises:
             DataError: the batch's indices are out of range or two boxes share a node.
             ModelError: the batch's M differs from the model's.
@@ -209,6 +213,7 @@ class SeanNet(nn.Module):
                 f"batch has M = {batch.num_slots} slots, the model {self.num_slots}; build the "
                 f"model with num_slots={batch.num_slots} or fix the dataset's slot table"
             )
+        batch = batch.prepare()
         batch.validate(num_classes=self.num_classes)
         c4 = self.backbone(batch.images)
         c5 = self.head[0](c4)  # the 5th stage, shared by the image vector and x_v

@@ -12,7 +12,7 @@ import torch
 from PIL import Image
 from torch import Tensor
 
-from seannet.batch import NUM_RELATIONS
+from seannet.batch import NUM_RELATIONS, normalise_pixels
 from seannet.errors import DataError
 from sgdata.annotate.relations import RelationType
 
@@ -86,20 +86,36 @@ class ImageTransform:
         Returns:
             ``(image, boxes)``: (3, size, size) float32 and (K, 4) float32 in the new frame.
         """
+        pixels, boxes_out = self.resize(rgb, boxes)
+        image = normalise_pixels(torch.tensor(pixels).permute(2, 0, 1), self.mean, self.std)
+        return image, boxes_out
+
+    def resize(self, rgb: np.ndarray, boxes: np.ndarray) -> tuple[np.ndarray, Tensor]:
+        """The first half of :meth:`__call__`: resize only, the pixels left as uint8.
+
+        The loaders carry these pixels (and :meth:`scale_boxes`'s boxes) to the model's
+        device, where :func:`~seannet.batch.normalise_pixels` with this transform's mean and
+        std finishes the job (``SceneBatch.prepare``): the same numbers as :meth:`__call__`.
+
+        Returns:
+            ``(pixels, boxes)``: (size, size, 3) uint8 (``rgb`` itself when already at size)
+            and (K, 4) float32 in the new frame.
+        """
         h, w = rgb.shape[:2]
         s = self.size
         if (h, w) != (s, s):
             rgb = np.asarray(Image.fromarray(rgb).resize((s, s), Image.Resampling.BILINEAR))
-        # (x / 255 - mean) / std as one multiply-add, on the CHW copy of the uint8 pixels
-        std = np.asarray(self.std, dtype=np.float64)
-        scale = (1.0 / (255.0 * std)).astype(np.float32)[:, None, None]
-        offset = (-np.asarray(self.mean, dtype=np.float64) / std).astype(np.float32)[:, None, None]
-        x = np.ascontiguousarray(rgb.transpose(2, 0, 1)).astype(np.float32)
-        x *= scale
-        x += offset
-        image = torch.from_numpy(x)
-        scale = np.asarray([s / w, s / h, s / w, s / h], dtype=np.float32)
-        return image, torch.from_numpy(np.asarray(boxes, dtype=np.float32).reshape(-1, 4) * scale)
+        return rgb, torch.from_numpy(self.scale_boxes(boxes, np.asarray([[h, w]])))
+
+    def scale_boxes(self, boxes: np.ndarray, source_hw: np.ndarray) -> np.ndarray:
+        """(K, 4) boxes from frames of ``source_hw`` (K, 2) (or (1, 2) for all) to size x size.
+
+        In float32, by ``size / width`` and ``size / height`` rounded to float32 once.
+        """
+        hw = np.asarray(source_hw, dtype=np.float64).reshape(-1, 2)
+        s = float(self.size)
+        scale = np.stack((s / hw[:, 1], s / hw[:, 0]), axis=1)[:, [0, 1, 0, 1]].astype(np.float32)
+        return np.asarray(boxes, dtype=np.float32).reshape(-1, 4) * scale
 
 
 # ---------------------------------------------------------------------------------- graphs

@@ -135,8 +135,13 @@ def test_image_transform_resizes_scales_boxes_and_normalises() -> None:
 
 
 def _check_batch(batch: SceneBatch, n: int, m: int) -> None:
-    assert batch.images.shape == (n, 3, SIZE, SIZE) and batch.images.dtype == torch.float32
-    assert batch.adjacency.shape == (n, 3, m, m)
+    # the loaders' compact form: uint8 pixels and a sparse adjacency, prepared by the model
+    assert batch.images.shape == (n, 3, SIZE, SIZE) and batch.images.dtype == torch.uint8
+    assert batch.adjacency.shape == (n, 3, m, m) and batch.adjacency.is_sparse
+    assert not batch.prepared
+    batch = batch.prepare()
+    assert batch.images.dtype == torch.float32 and batch.images.is_contiguous()
+    assert batch.adjacency.layout == torch.strided and batch.mean is None
     batch.validate()
     assert bool((batch.boxes >= 0).all()) and bool((batch.boxes <= SIZE).all())
     assert bool((batch.boxes[:, 2:] > batch.boxes[:, :2]).all())
@@ -164,10 +169,11 @@ def test_triplet_batch_shapes_boxes_and_adjacency(
     rows = ds.observations("train", columns=["obs_id", "objects", "relations"]).to_pylist()
     objects = {r["obs_id"]: r["objects"] for r in rows}
     relations = {r["obs_id"]: r["relations"] for r in rows}
+    dense = positives.prepare().adjacency
     for b, obs in enumerate(meta["positive"]):  # the batch's dense adjacency is the row's
         expected = reference_graph(objects[obs], relations[obs], 256)
-        np.testing.assert_allclose(positives.adjacency[b].numpy(), expected, atol=1e-6)
-        assert torch.equal(items[b].positive.adjacency, positives.adjacency[b])
+        np.testing.assert_allclose(dense[b].numpy(), expected, atol=1e-6)
+        assert torch.equal(items[b].positive.adjacency, dense[b])
     first = objects[meta["negative"][0]]
     got = negatives.boxes[negatives.box_view == 0]
     want = torch.tensor([o["box2d"] for o in first], dtype=torch.float32) * (SIZE / 96)
@@ -183,6 +189,7 @@ def test_workers_yield_the_same_tensors(mini_dataset: Path) -> None:
     assert len(serial) == len(parallel) == -(-len(data) // 5)
     for a, b in zip(serial, parallel, strict=True):
         for x, y in zip(a[:3], b[:3], strict=True):
+            x, y = x.prepare(), y.prepare()
             for name in ("images", "boxes", "box_view", "class_ids", "slots", "adjacency"):
                 assert torch.equal(getattr(x, name), getattr(y, name)), name
         assert a[3]["anchor"] == b[3]["anchor"]

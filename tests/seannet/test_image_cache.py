@@ -107,6 +107,7 @@ def test_workers_get_the_same_tensors(mini_dataset: Path, tmp_path: Path) -> Non
     assert len(serial) == len(parallel)
     for a, b in zip(serial, parallel, strict=True):
         for x, y in zip(a[:3], b[:3], strict=True):
+            x, y = x.prepare(), y.prepare()
             for name in ("images", "boxes", "box_view", "class_ids", "slots", "adjacency"):
                 assert torch.equal(getattr(x, name), getattr(y, name)), name
         assert a[3]["anchor"] == b[3]["anchor"]
