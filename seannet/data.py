@@ -31,12 +31,10 @@ import json
 import os
 import sys
 from collections.abc import Sequence
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pyarrow as pa
 import pyarrow.parquet as pq
 from torch import Tensor
 from torch.utils.data import Dataset as TorchDataset
@@ -53,13 +51,13 @@ from seannet.collate import (
 )
 from seannet.errors import DataError
 from seannet.image_cache import CachedImages, open_image_cache
+from seannet.split_graphs import SplitGraphs, flatten_lists, offsets_of, view_spans
 from seannet.view_inputs import (
     IMAGENET_MEAN,
     IMAGENET_STD,
     ImageTransform,
     graph_from_columns,
     graph_tensors,
-    struct_columns,
 )
 from sgdata.dataset import Dataset, decode_image, observations_schema, read_table
 from sgdata.errors import DatasetError
@@ -152,10 +150,10 @@ class _Shard:
         except DatasetError as exc:
             raise DataError(_one_line(str(exc))) from None
         self.images = table.column("image") if with_images else None
-        self.obj_offsets, obj = _flatten_lists(
+        self.obj_offsets, obj = flatten_lists(
             table.column("objects"), ("instance", "class_id", "slot", "box2d")
         )
-        self.rel_offsets, rel = _flatten_lists(table.column("relations"), ("src", "dst", "type"))
+        self.rel_offsets, rel = flatten_lists(table.column("relations"), ("src", "dst", "type"))
         self.instance, self.class_id, self.slot, self.box2d = (
             obj["instance"],
             obj["class_id"],
@@ -181,71 +179,6 @@ class _Shard:
             self.type[r0:r1],
             num_slots,
         )
-
-
-def _flatten_lists(
-    column: pa.ChunkedArray, names: Sequence[str]
-) -> tuple[np.ndarray, dict[str, np.ndarray]]:
-    """A list<struct> column as (offsets (N+1,), {field: values}) numpy arrays."""
-    lists = column.combine_chunks() if column.num_chunks != 1 else column.chunk(0)
-    offsets = lists.offsets.to_numpy().astype(np.int64)
-    values = struct_columns(lists.flatten(), names)
-    return offsets - offsets[0], values
-
-
-@dataclass
-class _SplitGraphs:
-    """Every view's graph tensors of one split, concatenated in storage order (numpy).
-
-    View v's objects are rows ``box_offsets[v]:[v + 1]`` of ``slots``, ``class_ids`` and
-    ``boxes``; its adjacency cells columns ``edge_offsets[v]:[v + 1]`` of ``edges`` (3, E)
-    [relation, row slot, column slot] and ``edge_weight`` (E,). A batch is gathered from
-    them with a few vectorised takes (:meth:`_ViewStore.gather`), whatever its size.
-    """
-
-    box_offsets: np.ndarray
-    slots: np.ndarray
-    class_ids: np.ndarray
-    boxes: np.ndarray  # (K, 4) float32: in the cached S x S frame with the cache, else as stored
-    edge_offsets: np.ndarray
-    edges: np.ndarray
-    edge_weight: np.ndarray
-
-    spans: np.ndarray = field(init=False)  # (N, 4): first object, objects, first cell, cells
-
-    def __post_init__(self) -> None:
-        b, e = self.box_offsets, self.edge_offsets
-        self.spans = np.stack((b[:-1], np.diff(b), e[:-1], np.diff(e)), axis=1)
-
-
-def _offsets(counts: Sequence[int]) -> np.ndarray:
-    return np.concatenate(([0], np.cumsum(np.asarray(counts, dtype=np.int64))))
-
-
-def _spans(
-    spans: np.ndarray, rows: np.ndarray, local: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, list[np.ndarray], list[np.ndarray]]:
-    """The objects and the adjacency cells of views ``rows``, concatenated in row order.
-
-    Args:
-        spans: (N, 4) int64 per view: first object, object count, first cell, cell count.
-        rows: (n,) the views.
-        local: (n,) each row's view index within its batch.
-
-    Returns:
-        ``(box_offsets, edge_offsets, [object index, cell index], [object view, cell view])``:
-        (n + 1,) offsets of each row's range in the concatenation, the (K,) and (E,) indices
-        into the split's arrays, and the ``local`` view of each.
-    """
-    sp = spans[rows]
-    out = np.zeros((len(rows) + 1, 2), dtype=np.int64)
-    np.cumsum(sp[:, 1::2], axis=0, out=out[1:])
-    index, owner = [], []
-    for k in (0, 1):
-        starts, counts = sp[:, 2 * k], sp[:, 2 * k + 1]
-        index.append(np.arange(out[-1, k]) + (starts - out[:-1, k]).repeat(counts))
-        owner.append(local.repeat(counts))
-    return out[:, 0], out[:, 1], index, owner
 
 
 class _PixelBuffers:
@@ -285,7 +218,7 @@ class _ViewStore:
     Holds only plain state when pickled or forked; shards are read in the process that asks
     for a view (``os.getpid()`` keys the cache, so a fork never reuses the parent's). The first
     read in a process reads the split's graph columns and builds every view's graph tensors
-    once (:class:`_SplitGraphs`; ``medium``'s 8,013 train views: 1.5-2 s here).
+    once (:class:`SplitGraphs`; ``medium``'s 8,013 train views: 1.5-2 s here).
     """
 
     def __init__(
@@ -305,13 +238,13 @@ class _ViewStore:
         rows = [pq.read_metadata(p).num_rows for p in self.files]
         if sum(rows) != len(self.obs_ids):
             raise DataError(f"split {split!r}: observation shards changed while being read")
-        self.file_starts = _offsets(rows)
+        self.file_starts = offsets_of(rows)
         self.index = {obs: v for v, obs in enumerate(self.obs_ids)}
         if len(self.index) != len(self.obs_ids):
             raise DataError(f"split {split!r}: an obs_id repeats across its observation shards")
         self._pid: int | None = None
         self._shards: dict[int, _Shard] = {}
-        self._graphs: _SplitGraphs | None = None
+        self._graphs: SplitGraphs | None = None
         self._buffers = _PixelBuffers()
         self._local: dict[tuple[int, int], np.ndarray] = {}  # (n, block): view within batch
         self.mean: tuple[float, float, float] = tuple(transform.mean)  # type: ignore[assignment]
@@ -354,14 +287,14 @@ class _ViewStore:
             shard = self._shards[f] = _Shard(Path(self.files[f]), with_images=self.cached is None)
         return shard
 
-    def graphs(self) -> _SplitGraphs:
+    def graphs(self) -> SplitGraphs:
         """The split's graph tensors, built on first use in this process."""
         self._own()
         if self._graphs is None:
             self._graphs = self._build_graphs()
         return self._graphs
 
-    def _build_graphs(self) -> _SplitGraphs:
+    def _build_graphs(self) -> SplitGraphs:
         parts: list[tuple[Tensor, ...]] = []
         for f in range(len(self.files)):
             shard = self.shard(f)
@@ -374,18 +307,18 @@ class _ViewStore:
                     obs = self.obs_ids[int(self.file_starts[f]) + row]
                     raise DataError(f"observation {obs!r}: {exc}") from None
         slots, class_ids, boxes, edges, weights = ([p[k].numpy() for p in parts] for k in range(5))
-        box_offsets = _offsets([len(x) for x in slots])
+        box_offsets = offsets_of([len(x) for x in slots])
         boxes_all = np.concatenate(boxes).reshape(-1, 4) if parts else np.zeros((0, 4))
         boxes_all = boxes_all.astype(np.float32, copy=False)
         if self.cached is not None:  # into the cached frame, once
             hw = np.repeat(self.cached.source_hw, np.diff(box_offsets), axis=0)
             boxes_all = self.transform.scale_boxes(boxes_all, hw)
-        return _SplitGraphs(
+        return SplitGraphs(
             box_offsets=box_offsets,
             slots=np.concatenate(slots) if parts else np.zeros(0, np.int64),
             class_ids=np.concatenate(class_ids) if parts else np.zeros(0, np.int64),
             boxes=boxes_all,
-            edge_offsets=_offsets([x.shape[0] for x in weights]),
+            edge_offsets=offsets_of([x.shape[0] for x in weights]),
             edges=np.concatenate(edges, axis=1) if parts else np.zeros((3, 0), np.int64),
             edge_weight=np.concatenate(weights) if parts else np.zeros(0, np.float32),
         )
@@ -397,7 +330,9 @@ class _ViewStore:
         local = self._local.get((len(rows), block))
         if local is None:
             local = self._local[len(rows), block] = np.arange(len(rows)) % block
-        box_offsets, edge_offsets, (at, cells), (box_view, edge_view) = _spans(g.spans, rows, local)
+        box_offsets, edge_offsets, (at, cells), (box_view, edge_view) = view_spans(
+            g.spans, rows, local
+        )
         edges = np.empty((4, len(cells)), dtype=np.int64)
         edges[0] = edge_view
         np.take(g.edges, cells, axis=1, out=edges[1:], mode="clip")
