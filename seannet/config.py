@@ -103,9 +103,9 @@ PRESETS: dict[str, TrainConfig] = {
         max_val_triplets=160,
         num_workers=0,
     ),
-    # One GPU (measured on an H100 with 16 cores): ResNet-18 at the datasets' 224 px, x_v from
-    # the 5th-stage map, the cpu preset's schedule; loader workers decode the PNGs in parallel
-    # so the GPU is not left waiting.
+    # One GPU (run on an H100 with 16 cores, docs/results.md): ResNet-18 at the datasets'
+    # 224 px, x_v from the 5th-stage map, the cpu preset's schedule; loader workers decode the
+    # PNGs in parallel (the runs there were still loader-bound).
     "gpu": TrainConfig(
         depth=18,
         roi_size=14,
