@@ -21,8 +21,8 @@ class ImageEncoder(nn.Module):
     dropped (see :func:`seannet.backbones.image_encoder`); where its native feature width
     differs from ``embed_dim`` (ResNet-18/34: 512, GoogLeNet: 1024, EfficientNet-Lite0: 1280,
     VGG-16: 4096), one linear
-    layer projects it to ``embed_dim``, so every model's embedding is the same size and the
-    same similarity threshold analysis applies. ResNet-50 and ResNeXt-50 (2048) are used as is.
+    layer projects it to ``embed_dim``, the width of SeanNet's fused vector, so the same
+    similarity threshold analysis applies. ResNet-50 and ResNeXt-50 (2048) are used as is.
 
     Args:
         name: ``"resnet18"``, ``"resnet34"``, ``"resnet50"``, ``"resnext50"``, ``"vgg16"``,
@@ -51,6 +51,7 @@ class ImageEncoder(nn.Module):
             raise ModelError(f"embed_dim={embed_dim}; expected a positive integer")
         self.name = name
         self.embed_dim = embed_dim
+        self.out_dim = embed_dim  # the embedding's width, as SeanNet.out_dim
         self.encoder, self.native_dim = image_encoder(
             name, pretrained=pretrained, sha256=pretrained_sha256
         )

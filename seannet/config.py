@@ -27,6 +27,9 @@ class TrainConfig:
     # the 5th-stage map computed once per image: no head pass per object)
     visual_features: str = "c4_head"
     embed_dim: int = 2048
+    # cells per side of SeanNet's layout pathway (the scene graph's boxes slot by slot,
+    # seannet.layers.SlotLayout); 0 leaves the paper's graph branch (GCN pathways only)
+    layout_grid: int = 8
     dropout: float = 0.2  # on the GCN layers (paper §V-B)
     epochs: int = 60
     batch_size: int = 14  # the paper's SeanNet batch
@@ -59,6 +62,8 @@ class TrainConfig:
             raise ModelError(f"train.depth {self.depth}: expected 18, 34 or 50")
         if not 0.0 <= self.dropout < 1.0:
             raise ModelError(f"train.dropout must be within [0, 1), got {self.dropout}")
+        if self.layout_grid < 0:
+            raise ModelError(f"train.layout_grid must be >= 0, got {self.layout_grid}")
         if self.new_layers_lr_scale <= 0:
             raise ModelError(
                 f"train.new_layers_lr_scale must be > 0, got {self.new_layers_lr_scale}"
@@ -71,6 +76,12 @@ class TrainConfig:
         """The image network's family, which fixes the input normalisation."""
         lite = "efficientnet_lite0"
         return lite if lite in (self.model, self.backbone) else "resnet"
+
+    @classmethod
+    def from_dict(cls, raw: dict[str, Any]) -> TrainConfig:
+        """The config a checkpoint stored (:meth:`to_dict`). Checkpoints written before the
+        layout pathway existed lack ``layout_grid``: their models had none (0)."""
+        return cls(**{"layout_grid": 0, **raw})
 
     def replace(self, **changes: Any) -> TrainConfig:
         """A copy with some fields changed (validated again)."""

@@ -54,7 +54,7 @@ def evaluate_run(run: Path, data: Path, *, split: str = "test", out: Path | None
         saved = {k: saved.get(k) for k in MODEL_KEYS}
         current = {k: current.get(k) for k in MODEL_KEYS}
     check_same_dataset(path, saved, current)
-    config = TrainConfig(**state["config"])
+    config = TrainConfig.from_dict(state["config"])
     device = device_for_run()
     model = build_for_dataset(config, data).to(device)
     model.load_state_dict(state["model"])

@@ -59,7 +59,7 @@ class Localizer:
             vectors = self.model.embed(batch.to(self.device))
             out.append(torch.nn.functional.normalize(vectors, dim=1).cpu().numpy())
         if not out:
-            return np.zeros((0, self.config.embed_dim), dtype=np.float32)
+            return np.zeros((0, self.model.out_dim), dtype=np.float32)
         return np.concatenate(out).astype(np.float32)
 
 
@@ -126,7 +126,7 @@ def load_localizer(
         source = "--epsilon"
     if require_epsilon and not math.isfinite(epsilon):
         raise NavigationError(f"epsilon {epsilon}: expected a finite number")
-    config = TrainConfig(**state["config"])
+    config = TrainConfig.from_dict(state["config"])
     device = device_for_run()
     model = build_for_dataset(config, data).to(device)
     model.load_state_dict(state["model"])

@@ -8,13 +8,14 @@ from pathlib import Path
 import numpy as np
 import torch
 from torch import Tensor, nn
+from torch.nn import functional as F
 from torchvision.ops import roi_align
 
 from seannet.backbones import ENCODER_NAMES, efficientnet_lite0_c4, resnet_c4
 from seannet.baselines import ImageEncoder
 from seannet.batch import NUM_RELATIONS, SceneBatch
 from seannet.errors import ModelError
-from seannet.layers import MultiPathwayGCN, ObjectEmbedding
+from seannet.layers import MultiPathwayGCN, ObjectEmbedding, SlotLayout
 from seannet.layers.object_embedding import OBJECT_INPUTS
 from seannet.wordvectors import WordVectorTable
 
@@ -29,6 +30,7 @@ ABLATIONS: dict[str, dict] = {
     "seannet-noword": {"object_inputs": ("visual", "box")},
     "seannet-novisual": {"object_inputs": ("box", "word")},
     "seannet-nobox": {"object_inputs": ("visual", "word")},
+    "seannet-nolayout": {"layout_grid": 0},  # the paper's graph branch: GCN pathways only
 }
 MODEL_NAMES = ("seannet", *ABLATIONS, *ENCODER_NAMES)
 
@@ -55,13 +57,21 @@ class SeanNet(nn.Module):
        view-to-view variation came 4.1 from the image and 0.023 from the graph — then
        concatenate and apply one linear layer. No activation after it: the embedding takes
        either sign, so cosine similarity uses the whole sphere rather than one orthant.
+    5. **Layout pathway** (not in the paper; ``layout_grid`` > 0, the default): the
+       :class:`~seannet.layers.SlotLayout` vector of the scene graph's boxes, slot by slot
+       (B × M·grid²), joins the embedding as a second unit vector:
+       :math:`[f / \|f\|;\; \lambda\, \ell / \|\ell\|]` with a learned
+       :math:`\lambda` (initially 1), so the cosine similarity of two views is
+       :math:`(S_f + \lambda^2 S_\ell) / (1 + \lambda^2)`. Without it the graph branch adds
+       nothing measurable to the image (``docs/results.md``): the GCN pathways never learn how
+       far the same objects' boxes moved, which is what ranks the triplets.
 
     ``visual_features`` picks how :math:`x_v` is computed: ``"c4_head"`` as the paper (RoIAlign
     on C4, then the head on every crop: ~55 % of a CPU step), or ``"c5"`` (RoIAlign on the
     head's 5th-stage map, computed once per image for the image branch anyway, then averaged:
     the same features at the box, without a head pass per object). ``branches`` and
     ``object_inputs`` switch parts off for ablations (``"image"``: no scene graph at all;
-    ``"graph"``: no image vector in the fusion).
+    ``"graph"``: no image vector in the fusion); ``layout_grid=0`` leaves the paper's branch.
 
     Dropout (0.2) is used in the GCN only, as in the paper (§V-B).
 
@@ -86,10 +96,12 @@ class SeanNet(nn.Module):
         backbone: ``"resnet"`` (default, of ``depth``) or ``"efficientnet_lite0"`` (split at
             stride 16 like C4; ``pretrained="imagenet-lite0"`` loads its ImageNet weights
             from the optional ``lite`` extra).
+        layout_grid: cells per side of the layout pathway (default 8; 0: no layout pathway).
 
     Shapes:
         - **batch**: a :class:`~seannet.batch.SceneBatch` with B views, K boxes, M slots
-        - **output**: :math:`(B, \text{embed\_dim})`
+        - **output**: :math:`(B, \text{out\_dim})`: ``embed_dim``, plus M · layout_grid² with
+          the layout pathway
     """
 
     def __init__(
@@ -111,8 +123,11 @@ class SeanNet(nn.Module):
         branches: str = "both",
         object_inputs: Sequence[str] = OBJECT_INPUTS,
         backbone: str = "resnet",
+        layout_grid: int = 8,
     ) -> None:
         super().__init__()
+        if layout_grid < 0:
+            raise ModelError(f"layout_grid={layout_grid}; expected 0 (off) or a positive integer")
         if visual_features not in VISUAL_FEATURES:
             raise ModelError(
                 f"visual_features={visual_features!r}; expected one of {VISUAL_FEATURES}"
@@ -157,6 +172,12 @@ class SeanNet(nn.Module):
         self.graph_norm = nn.LayerNorm(embed_dim)
         widths = {"both": split.head_dim + embed_dim, "image": split.head_dim, "graph": embed_dim}
         self.fusion = nn.Linear(widths[branches], embed_dim)
+        self.layout: SlotLayout | None = None
+        self.out_dim = embed_dim
+        if layout_grid and branches != "image":
+            self.layout = SlotLayout(num_slots, self.num_classes, grid=layout_grid)
+            self.layout_weight = nn.Parameter(torch.ones(()))  # lambda
+            self.out_dim += self.layout.out_dim
 
     @property
     def num_classes(self) -> int:
@@ -227,7 +248,22 @@ class SeanNet(nn.Module):
                 x = c4.new_zeros(0, self.objects.out_dim)
             graph = self.gcn(self.node_features(x, batch), batch.adjacency.to(c4.dtype))
             parts.append(self.graph_norm(graph))
-        return self.fusion(torch.cat(parts, dim=1))
+        fused = self.fusion(torch.cat(parts, dim=1))
+        if self.layout is None:
+            return fused
+        height, width = batch.images.shape[-2:]
+        layout = self.layout(
+            batch.boxes,
+            batch.box_view,
+            batch.slots,
+            batch.class_ids,
+            num_views=batch.num_views,
+            height=height,
+            width=width,
+        )
+        return torch.cat(
+            (F.normalize(fused, dim=1), self.layout_weight * F.normalize(layout, dim=1)), dim=1
+        )
 
     def forward(self, batch: SceneBatch) -> Tensor:
         return self.embed(batch)
@@ -247,6 +283,7 @@ def build_model(
     pretrained_sha256: str | None = None,
     visual_features: str = "c5",
     backbone: str = "resnet",
+    layout_grid: int = 8,
 ) -> SeanNet | ImageEncoder:
     """SeanNet or an image baseline by name; every model has ``embed(batch) -> (B, D)``.
 
@@ -264,6 +301,7 @@ def build_model(
         pretrained_sha256: its expected SHA-256 (default: torchvision's known weights).
         visual_features: how SeanNet computes :math:`x_v` (see :class:`SeanNet`).
         backbone: SeanNet's image network (see :class:`SeanNet`).
+        layout_grid: SeanNet's layout pathway (see :class:`SeanNet`; 0 = off).
 
     Raises:
         ModelError: an unknown name or a bad hyper-parameter or weights file.
@@ -293,6 +331,5 @@ def build_model(
         pretrained=pretrained,
         pretrained_sha256=pretrained_sha256,
         visual_features=visual_features,
-        backbone=backbone,
-        **ABLATIONS.get(name, {}),
+        **{"backbone": backbone, "layout_grid": layout_grid, **ABLATIONS.get(name, {})},
     )

@@ -77,6 +77,7 @@ def build_for_dataset(  # noqa: ANN201
         pretrained_sha256=pretrained_sha256,
         visual_features=config.visual_features,
         backbone=config.backbone,
+        layout_grid=config.layout_grid,
     )
 
 
@@ -134,7 +135,7 @@ def train(
         state = load_checkpoint(last)
         check_same_dataset(last, state["dataset"], identity)
         # a resumed run may be given more epochs; everything else must match
-        saved = {**state["config"], "epochs": config.epochs}
+        saved = {**TrainConfig.from_dict(state["config"]).to_dict(), "epochs": config.epochs}
         if saved != config.to_dict():
             raise CheckpointError(f"{last}: was trained with another config; resume with that one")
         model.load_state_dict(state["model"])

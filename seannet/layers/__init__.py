@@ -1,8 +1,10 @@
-"""SeanNet's layers, one per module: box encoding, object embedding, multi-pathway GCN."""
+"""SeanNet's layers, one per module: box encoding, object embedding, multi-pathway GCN,
+slot layout."""
 
 from seannet.layers.box_encoding import BoxEncoding, sinusoidal_encoding
 from seannet.layers.gcn import GCNLayer, GCNPathway, MultiPathwayGCN
 from seannet.layers.object_embedding import ObjectEmbedding
+from seannet.layers.slot_layout import SlotLayout, box_coverage
 
 __all__ = [
     "BoxEncoding",
@@ -10,5 +12,7 @@ __all__ = [
     "GCNPathway",
     "MultiPathwayGCN",
     "ObjectEmbedding",
+    "SlotLayout",
+    "box_coverage",
     "sinusoidal_encoding",
 ]

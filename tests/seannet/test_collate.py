@@ -129,7 +129,7 @@ def test_views_without_objects_or_edges(mini_dataset: Path) -> None:
     model = build_model("seannet", depth=18, num_slots=256, roi_size=7).eval()
     with torch.no_grad():
         out = model.embed(collate_views([empty, empty])[0])  # no box in the whole batch
-    assert out.shape == (2, 2048) and bool(torch.isfinite(out).all())
+    assert out.shape == (2, model.out_dim) and bool(torch.isfinite(out).all())
 
 
 def test_mixed_views_are_refused(mini_dataset: Path) -> None:

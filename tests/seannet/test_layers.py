@@ -1,4 +1,5 @@
-"""SeanNet's layers: box positional encoding, GCN layer / pathway / multi-pathway, object fcn."""
+"""SeanNet's layers: box positional encoding, GCN layer / pathway / multi-pathway, object fcn,
+slot layout."""
 
 from __future__ import annotations
 
@@ -13,6 +14,8 @@ from seannet.layers import (
     GCNPathway,
     MultiPathwayGCN,
     ObjectEmbedding,
+    SlotLayout,
+    box_coverage,
     sinusoidal_encoding,
 )
 
@@ -141,3 +144,53 @@ def test_object_embedding_widths_and_fixed_word_vectors() -> None:
     assert "word_vectors" not in dict(emb.named_parameters())
     with pytest.raises(ModelError, match="word_vectors: shape"):
         ObjectEmbedding(torch.randn(300), 2048)
+
+
+# ------------------------------------------------------------------------------ slot layout
+
+
+def test_box_coverage_is_the_share_of_each_cell() -> None:
+    boxes = torch.tensor(
+        [
+            [0.0, 0.0, 16.0, 16.0],  # exactly the top-left cell of a 4 x 4 grid on 64 px
+            [0.0, 0.0, 64.0, 64.0],  # the whole image
+            [40.0, 8.0, 56.0, 24.0],  # half of each of 4 cells across and down: 1/4 each
+        ]
+    )
+    cells = box_coverage(boxes, 64, 64, 4).view(3, 4, 4)
+    assert torch.equal(cells[0], F.one_hot(torch.tensor(0), 16).view(4, 4).float())
+    assert torch.equal(cells[1], torch.ones(4, 4))
+    expected = torch.zeros(4, 4)
+    expected[0:2, 2:4] = 0.25
+    torch.testing.assert_close(cells[2], expected)
+    # a non-square frame: u is scaled by the width, v by the height
+    wide = box_coverage(torch.tensor([[0.0, 0.0, 32.0, 16.0]]), 64, 128, 4).view(4, 4)
+    assert torch.equal(wide, F.one_hot(torch.tensor(0), 16).view(4, 4).float())
+
+
+def test_slot_layout_compares_the_same_objects_boxes() -> None:
+    """Same box in the same slot: the class weight squared; a shifted box less; another slot
+    or an absent object nothing; and the weights learn."""
+    layout = SlotLayout(num_slots=6, num_classes=3, grid=4)
+    boxes = torch.tensor(
+        [[0.0, 0.0, 32.0, 32.0], [0.0, 0.0, 32.0, 32.0], [8.0, 0.0, 40.0, 32.0], [0, 0, 32, 32]]
+    )
+    out = layout(
+        boxes,
+        box_view=torch.tensor([0, 1, 2, 3]),
+        slots=torch.tensor([2, 2, 2, 4]),
+        class_ids=torch.tensor([1, 1, 1, 1]),
+        num_views=5,
+        height=64,
+        width=64,
+    )
+    assert out.shape == (5, layout.out_dim) and layout.out_dim == 6 * 16
+    same, shifted, other_slot = out[0] @ out[1], out[0] @ out[2], out[0] @ out[3]
+    torch.testing.assert_close(same, torch.tensor(1.0))
+    assert 0.0 < shifted < same and other_slot == 0.0
+    assert torch.equal(out[4], torch.zeros(layout.out_dim))  # a view with no objects
+    same.backward()
+    grad = layout.class_weight.grad
+    assert grad[1] > 0 and grad[0] == 0 and grad[2] == 0  # only the class in view learns
+    with pytest.raises(ModelError, match="grid=0"):
+        SlotLayout(4, 2, grid=0)

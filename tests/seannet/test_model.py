@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import pytest
 import torch
+from torch.nn import functional as F
 
 from seannet import DataError, ModelError, SceneBatch, SeanNet, build_model
 from seannet.wordvectors import load_table
@@ -69,7 +70,8 @@ def test_shapes_through_the_network(model: SeanNet) -> None:
         x0 = model.node_features(x, batch)
         assert x0.shape == (2, M, 512)
         out = model.embed(batch)
-    assert out.shape == (2, 2048)
+    assert out.shape == (2, 2048 + M * 64)  # the fused vector, then the 8 x 8 layout grids
+    assert model.out_dim == out.shape[1]
     assert torch.isfinite(out).all()
     # objects land at (view, slot); every other row is zero, the empty view entirely
     assert torch.equal(x0[batch.box_view, batch.slots], x)
@@ -126,12 +128,48 @@ def test_training_step_reaches_every_part() -> None:
     net = SeanNet(torch.randn(102, 300), depth=18, num_slots=M, roi_size=7, graph_hidden_dim=64)
     net.train()
     out = net.embed(_batch((3, 2), seed=3))
-    out.square().mean().backward()
-    for name in ("backbone", "head", "objects", "gcn", "fusion"):
+    # a fixed direction: the embedding's parts are unit vectors, their norms carry no gradient
+    (out * torch.randn(out.shape, generator=torch.Generator().manual_seed(0))).sum().backward()
+    assert net.layout_weight.grad is not None and net.layout_weight.grad != 0
+    for name in ("backbone", "head", "objects", "gcn", "fusion", "layout"):
         grads = [p.grad for p in getattr(net, name).parameters()]
         assert all(g is not None for g in grads), name
         assert any(g.abs().sum() > 0 for g in grads), name
     assert not any(n.startswith("objects.word_vectors") for n, _ in net.named_parameters())
+
+
+def test_the_layout_pathway_sees_where_the_boxes_are(model: SeanNet) -> None:
+    """The embedding's tail is the slot layout: it moves with the boxes, is a unit vector
+    times lambda, and the cosine of two views mixes both parts as documented."""
+    batch = _batch((3, 2), seed=5)
+    moved = SceneBatch(**{**vars(batch), "boxes": batch.boxes + 20.0})
+    d = model.embed_dim
+    with torch.no_grad():
+        a, b = model.embed(batch), model.embed(moved)
+    torch.testing.assert_close(a[:, d:].norm(dim=1), model.layout_weight.detach().expand(2))
+    assert (a[:, d:] * b[:, d:]).sum(1).max() < 0.99  # boxes 20 px away overlap less
+    lam2 = float(model.layout_weight) ** 2
+    mixed = (
+        F.cosine_similarity(a[:, :d], b[:, :d]) + lam2 * F.cosine_similarity(a[:, d:], b[:, d:])
+    ) / (1 + lam2)
+    torch.testing.assert_close(F.cosine_similarity(a, b), mixed)
+
+
+def test_without_the_layout_pathway_the_graph_branch_is_the_papers() -> None:
+    from seannet.config import TrainConfig
+
+    torch.manual_seed(0)
+    net = build_model("seannet-nolayout", depth=18, num_slots=M, roi_size=7)
+    assert net.layout is None and net.out_dim == net.embed_dim == 2048
+    assert not any("layout" in n for n, _ in net.named_parameters())
+    with torch.no_grad():
+        assert net.embed(_batch((2,))).shape == (1, 2048)
+    # checkpoints from before the layout pathway stored no layout_grid: they had none
+    legacy = {k: v for k, v in TrainConfig().to_dict().items() if k != "layout_grid"}
+    assert TrainConfig.from_dict(legacy).layout_grid == 0
+    assert TrainConfig.from_dict(TrainConfig().to_dict()) == TrainConfig()
+    with pytest.raises(ModelError, match="layout_grid"):
+        TrainConfig(layout_grid=-1)
 
 
 def test_batch_checks(model: SeanNet) -> None:

@@ -1,0 +1,91 @@
+"""The layout pathway of the scene-graph branch: where each node's box lies, slot by slot."""
+
+from __future__ import annotations
+
+import torch
+from torch import Tensor, nn
+
+from seannet.errors import ModelError
+
+__all__ = ["SlotLayout", "box_coverage"]
+
+
+def box_coverage(boxes: Tensor, height: int, width: int, grid: int) -> Tensor:
+    """The share of each cell of a ``grid`` x ``grid`` partition of the image that each box
+    covers, row-major: (K, 4) pixel boxes [u1, v1, u2, v2] -> (K, grid * grid) in [0, 1].
+
+    The dot product of two boxes' rows is their overlap (in cell units), exact where the
+    boxes meet cell edges and a smoothed overlap elsewhere, so a box that slides by a few
+    pixels changes its row a little, not all at once.
+    """
+    edges = torch.linspace(0.0, 1.0, grid + 1, device=boxes.device, dtype=torch.float32)
+    scale = boxes.new_tensor([width, height, width, height], dtype=torch.float32)
+    b = boxes.to(torch.float32) / scale
+    lo, hi = edges[:-1] * grid, edges[1:] * grid
+    u1, v1, u2, v2 = (b[:, i : i + 1] * grid for i in range(4))
+    across = (torch.minimum(u2, hi) - torch.maximum(u1, lo)).clamp(0.0, 1.0)  # (K, G)
+    down = (torch.minimum(v2, hi) - torch.maximum(v1, lo)).clamp(0.0, 1.0)  # (K, G)
+    return (down.unsqueeze(2) * across.unsqueeze(1)).flatten(1)
+
+
+class SlotLayout(nn.Module):
+    r"""Each present node's box as a coarse occupancy grid in its slot, weighted by class.
+
+    The row of node i is :math:`w_{c_i}\, r_i / \|r_i\|`, with :math:`r_i` the
+    :func:`box_coverage` of its box and :math:`w_c` a learned weight per class (initially 1);
+    rows are scattered to (view, slot) and flattened, slot order kept, like the GCN's
+    outputs: (B, M · grid²). The dot product of two views' vectors is then
+    :math:`\sum_s w_{c_s}^2 \cos(r_s^A, r_s^B)` over the slots present in both: how far the
+    same objects' boxes overlap, the weights learning which classes are reliable landmarks
+    (the static ones) and which are noise (those people move).
+
+    Why: a triplet is decided by how the boxes of the *same* objects shifted between two
+    views. The GCN pathways squeeze a node to 8 numbers mixed with its neighbours before an
+    fc sees any slot, and on `medium` they learned next to nothing of it (a graph-only SeanNet
+    stayed near 60 % triplet accuracy), while this overlap, computed by hand from the boxes
+    of static and low-dynamic objects, ranks 85 % of the test triplets right, and added to a
+    trained ResNet-18's similarity lifts it from 85.0 to 88-90 % (``docs/results.md``).
+
+    Args:
+        num_slots: M.
+        num_classes: C, one weight per class.
+        grid: cells per side (default 8: 64 cells, 14 px at 112 px).
+
+    Shapes:
+        - **boxes**: :math:`(K, 4)` pixel boxes in the frame of an ``height`` x ``width`` image
+        - **box_view**, **slots**, **class_ids**: :math:`(K,)` long
+        - **output**: :math:`(B, M \cdot \text{grid}^2)`
+    """
+
+    def __init__(self, num_slots: int, num_classes: int, *, grid: int = 8) -> None:
+        super().__init__()
+        for name, value in (("num_slots", num_slots), ("num_classes", num_classes), ("grid", grid)):
+            if value <= 0:
+                raise ModelError(f"SlotLayout {name}={value}; expected a positive integer")
+        self.num_slots = num_slots
+        self.grid = grid
+        self.class_weight = nn.Parameter(torch.ones(num_classes))
+
+    @property
+    def out_dim(self) -> int:
+        return self.num_slots * self.grid * self.grid
+
+    def forward(
+        self,
+        boxes: Tensor,
+        box_view: Tensor,
+        slots: Tensor,
+        class_ids: Tensor,
+        *,
+        num_views: int,
+        height: int,
+        width: int,
+    ) -> Tensor:
+        cells = box_coverage(boxes, height, width, self.grid)
+        rows = cells / cells.norm(dim=1, keepdim=True).clamp_min(1e-12)
+        rows = rows * self.class_weight[class_ids].unsqueeze(1)
+        out = rows.new_zeros(num_views, self.num_slots, self.grid * self.grid)
+        return out.index_put((box_view, slots), rows).flatten(1)
+
+    def extra_repr(self) -> str:
+        return f"num_slots={self.num_slots}, grid={self.grid}"
