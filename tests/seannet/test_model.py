@@ -148,7 +148,7 @@ def test_the_layout_pathway_sees_where_the_boxes_are(model: SeanNet) -> None:
         a, b = model.embed(batch), model.embed(moved)
     torch.testing.assert_close(a[:, d:].norm(dim=1), model.layout_weight.detach().expand(2))
     assert (a[:, d:] * b[:, d:]).sum(1).max() < 0.99  # boxes 20 px away overlap less
-    lam2 = float(model.layout_weight) ** 2
+    lam2 = float(model.layout_weight.detach()) ** 2
     mixed = (
         F.cosine_similarity(a[:, :d], b[:, :d]) + lam2 * F.cosine_similarity(a[:, d:], b[:, d:])
     ) / (1 + lam2)
