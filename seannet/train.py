@@ -70,6 +70,7 @@ def build_for_dataset(  # noqa: ANN201
         depth=config.depth,
         num_slots=dataset.manifest.num_slots,
         class_names=list(dataset.class_names),
+        class_dynamics=[c.dynamics for c in dataset.manifest.classes],
         roi_size=config.roi_size,
         embed_dim=config.embed_dim,
         dropout=config.dropout,

@@ -221,3 +221,16 @@ def test_word_vectors_are_rows_in_class_id_order() -> None:
     # stored at unit length (raw GloVe norms of 4-8 would outweigh x_v and x_b)
     torch.testing.assert_close(net.objects.word_vectors[mug], raw / raw.norm())
     assert torch.allclose(net.objects.word_vectors.norm(dim=1), torch.ones(len(names)))
+
+
+def test_layout_class_weights_start_from_the_dynamics_category() -> None:
+    from seannet.model import LAYOUT_PRIOR
+
+    catalog = load_catalog()
+    net = build_model("seannet", depth=18, num_slots=M, roi_size=7)
+    weights = net.layout.class_weight.detach()
+    for i, name in enumerate(catalog.names()):
+        assert float(weights[i]) == LAYOUT_PRIOR[str(catalog.classes[name].dynamics)]
+    assert {float(w) for w in weights} == {1.0, 0.25}  # static and low at 1, high at 0.25
+    with pytest.raises(ModelError, match="class dynamics"):
+        build_model("seannet", depth=18, class_names=["Cup"], class_dynamics=["low", "high"])
