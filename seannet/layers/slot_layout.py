@@ -18,11 +18,11 @@ def box_coverage(boxes: Tensor, height: int, width: int, grid: int) -> Tensor:
     boxes meet cell edges and a smoothed overlap elsewhere, so a box that slides by a few
     pixels changes its row a little, not all at once.
     """
-    edges = torch.linspace(0.0, 1.0, grid + 1, device=boxes.device, dtype=torch.float32)
-    scale = boxes.new_tensor([width, height, width, height], dtype=torch.float32)
-    b = boxes.to(torch.float32) / scale
-    lo, hi = edges[:-1] * grid, edges[1:] * grid
-    u1, v1, u2, v2 = (b[:, i : i + 1] * grid for i in range(4))
+    # in cell units: cell c spans [c, c + 1)
+    scale = boxes.new_tensor([width, height, width, height], dtype=torch.float32) / grid
+    u1, v1, u2, v2 = (boxes.to(torch.float32) / scale).split(1, dim=1)  # (K, 1) each
+    lo = torch.arange(grid, device=boxes.device, dtype=torch.float32)
+    hi = lo + 1.0
     across = (torch.minimum(u2, hi) - torch.maximum(u1, lo)).clamp(0.0, 1.0)  # (K, G)
     down = (torch.minimum(v2, hi) - torch.maximum(v1, lo)).clamp(0.0, 1.0)  # (K, G)
     return (down.unsqueeze(2) * across.unsqueeze(1)).flatten(1)
