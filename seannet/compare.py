@@ -24,6 +24,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pyarrow.parquet as pq
 import torch
 from scipy import stats
 from torch.utils.data import DataLoader
@@ -38,7 +39,15 @@ from seannet.loss import TripletLoss
 from seannet.train import HISTORY, LAST, build_for_dataset, device_for_run, param_groups, train
 from sgdata.fileio import atomic_write_text
 
-__all__ = ["COMPARISON", "compare_models", "calibrate_batches", "model_spec", "summarize"]
+__all__ = [
+    "COMPARISON",
+    "calibrate_batches",
+    "compare_models",
+    "model_spec",
+    "paired_difference",
+    "summarize",
+    "triplets_per_room",
+]
 
 COMPARISON = "comparison"  # comparison.json and comparison.md under the output directory
 _CALIBRATION_STEPS = 3  # timed training steps (after one warm-up) per model
@@ -133,6 +142,9 @@ def compare_models(
             }
         )
     results["models"] = entries
+    counts = triplets_per_room(data, split)
+    for entry in entries[1:]:
+        entry["difference_to_first"] = paired_difference(entries[0]["runs"], entry["runs"], counts)
     out.mkdir(parents=True, exist_ok=True)
     atomic_write_text(out / f"{COMPARISON}.json", json.dumps(results, indent=2))
     atomic_write_text(out / f"{COMPARISON}.md", markdown(results))
@@ -208,6 +220,38 @@ def summarize(runs: list[dict[str, Any]]) -> dict[str, Any]:
     return summary
 
 
+def paired_difference(
+    runs_a: list[dict[str, Any]],
+    runs_b: list[dict[str, Any]],
+    triplets_per_room: dict[str, int],
+    *,
+    resamples: int = 10_000,
+) -> dict[str, float]:
+    """Triplet accuracy of A minus B on the same rooms, with a 95 % room-bootstrap interval.
+
+    Each room's accuracy is averaged over each model's seeds, the difference weighted by the
+    room's triplets; the rooms are resampled (a fixed seed: the same figures every time).
+    Why rooms: triplets of one room share its views and layouts, so they are not independent;
+    the rooms are, and pairing removes what the two models find equally hard.
+    """
+    rooms = sorted(triplets_per_room)
+    a = np.mean([[r["per_room"][room] for room in rooms] for r in runs_a], axis=0)
+    b = np.mean([[r["per_room"][room] for room in rooms] for r in runs_b], axis=0)
+    weight = np.array([triplets_per_room[room] for room in rooms], dtype=np.float64)
+    pick = np.random.default_rng(0).integers(0, len(rooms), size=(resamples, len(rooms)))
+    boot = ((a - b)[pick] * weight[pick]).sum(1) / weight[pick].sum(1)
+    low, high = np.percentile(boot, [2.5, 97.5])
+    diff = float(((a - b) * weight).sum() / weight.sum())
+    return {"mean": diff, "low": float(low), "high": float(high), "rooms": len(rooms)}
+
+
+def triplets_per_room(data: Path, split: str) -> dict[str, int]:
+    """How many ``split`` triplets each room holds (from the dataset's triplet table)."""
+    rooms = pq.read_table(data / "triplets" / f"{split}.parquet", columns=["room_id"])
+    names, counts = np.unique(rooms.column("room_id").to_numpy(), return_counts=True)
+    return {str(n): int(c) for n, c in zip(names, counts, strict=True)}
+
+
 def _pm(entry: dict[str, float]) -> str:
     mean, ci = 100 * entry["mean"], 100 * entry["ci95"]
     return f"{mean:.1f} ± {ci:.1f}" if not math.isnan(ci) else f"{mean:.1f}"
@@ -233,6 +277,15 @@ def markdown(results: dict[str, Any]) -> str:
             f"{_pm(tiers['1']) if '1' in tiers else '-'} | "
             f"{s['d_prime']['mean']:.2f} | {s['triplets']} / {s['rooms']} |"
         )
+    if len(results["models"]) > 1:
+        first = results["models"][0]["model"]
+        rows += ["", f"{first} minus each model, same rooms (95 % room-bootstrap interval):", ""]
+        for e in results["models"][1:]:
+            d = e["difference_to_first"]
+            rows.append(
+                f"- {e['model']}: {100 * d['mean']:+.1f} points "
+                f"[{100 * d['low']:+.1f}, {100 * d['high']:+.1f}] over {d['rooms']} rooms"
+            )
     rows += ["", "Accuracy by moved objects in view (mean over seeds, %):", ""]
     bins = list(results["models"][0]["summary"]["by_moved"]) if results["models"] else []
     rows += ["| model | " + " | ".join(bins) + " |", "|---|" + "---|" * len(bins)]

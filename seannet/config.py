@@ -29,7 +29,11 @@ class TrainConfig:
     embed_dim: int = 2048
     # cells per side of SeanNet's layout pathway (the scene graph's boxes slot by slot,
     # seannet.layers.SlotLayout); 0 leaves the paper's graph branch (GCN pathways only)
-    layout_grid: int = 8
+    layout_grid: int = 32
+    # the pathway's M x grid^2 coordinates folded into this many by a count sketch (0: kept
+    # as they are). On medium's val triplets the boxes alone rank 80.3 % at grid 8, 82.3 % at
+    # 32 unsketched (262,144 numbers per view) and 82.1 % at 32 sketched to 16,384
+    layout_sketch: int = 16384
     dropout: float = 0.2  # on the GCN layers (paper §V-B)
     epochs: int = 60
     batch_size: int = 14  # the paper's SeanNet batch
@@ -62,8 +66,11 @@ class TrainConfig:
             raise ModelError(f"train.depth {self.depth}: expected 18, 34 or 50")
         if not 0.0 <= self.dropout < 1.0:
             raise ModelError(f"train.dropout must be within [0, 1), got {self.dropout}")
-        if self.layout_grid < 0:
-            raise ModelError(f"train.layout_grid must be >= 0, got {self.layout_grid}")
+        if self.layout_grid < 0 or self.layout_sketch < 0:
+            raise ModelError(
+                f"train.layout_grid and train.layout_sketch must be >= 0, got "
+                f"{self.layout_grid} and {self.layout_sketch}"
+            )
         if self.new_layers_lr_scale <= 0:
             raise ModelError(
                 f"train.new_layers_lr_scale must be > 0, got {self.new_layers_lr_scale}"
@@ -80,8 +87,9 @@ class TrainConfig:
     @classmethod
     def from_dict(cls, raw: dict[str, Any]) -> TrainConfig:
         """The config a checkpoint stored (:meth:`to_dict`). Checkpoints written before the
-        layout pathway existed lack ``layout_grid``: their models had none (0)."""
-        return cls(**{"layout_grid": 0, **raw})
+        layout pathway existed lack ``layout_grid`` (their models had none: 0), those written
+        before its sketch lack ``layout_sketch`` (their pathways kept every coordinate: 0)."""
+        return cls(**{"layout_grid": 0, "layout_sketch": 0, **raw})
 
     def replace(self, **changes: Any) -> TrainConfig:
         """A copy with some fields changed (validated again)."""

@@ -72,7 +72,8 @@ class SeanNet(nn.Module):
        either sign, so cosine similarity uses the whole sphere rather than one orthant.
     5. **Layout pathway** (not in the paper; ``layout_grid`` > 0, the default): the
        :class:`~seannet.layers.SlotLayout` vector of the scene graph's boxes, slot by slot
-       (B × M·grid²), joins the embedding as a second unit vector:
+       (B × M·grid², count-sketched to B × ``layout_sketch``), joins the embedding as a
+       second unit vector:
        :math:`[f / \|f\|;\; \lambda\, \ell / \|\ell\|]` with a learned
        :math:`\lambda` (initially 1), so the cosine similarity of two views is
        :math:`(S_f + \lambda^2 S_\ell) / (1 + \lambda^2)`. Without it the graph branch adds
@@ -109,13 +110,14 @@ class SeanNet(nn.Module):
         backbone: ``"resnet"`` (default, of ``depth``) or ``"efficientnet_lite0"`` (split at
             stride 16 like C4; ``pretrained="imagenet-lite0"`` loads its ImageNet weights
             from the optional ``lite`` extra).
-        layout_grid: cells per side of the layout pathway (default 8; 0: no layout pathway).
+        layout_grid: cells per side of the layout pathway (default 32; 0: no layout pathway).
         layout_weights: :math:`(C,)` its starting class weights (default 1 each).
+        layout_sketch: its count-sketch width (default 16,384; 0: M · layout_grid² wide).
 
     Shapes:
         - **batch**: a :class:`~seannet.batch.SceneBatch` with B views, K boxes, M slots
-        - **output**: :math:`(B, \text{out\_dim})`: ``embed_dim``, plus M · layout_grid² with
-          the layout pathway
+        - **output**: :math:`(B, \text{out\_dim})`: ``embed_dim``, plus the layout pathway's
+          ``layout_sketch`` (or M · layout_grid² unsketched)
     """
 
     def __init__(
@@ -137,8 +139,9 @@ class SeanNet(nn.Module):
         branches: str = "both",
         object_inputs: Sequence[str] = OBJECT_INPUTS,
         backbone: str = "resnet",
-        layout_grid: int = 8,
+        layout_grid: int = 32,
         layout_weights: Tensor | None = None,
+        layout_sketch: int = 16384,
     ) -> None:
         super().__init__()
         if layout_grid < 0:
@@ -191,7 +194,11 @@ class SeanNet(nn.Module):
         self.out_dim = embed_dim
         if layout_grid and branches != "image":
             self.layout = SlotLayout(
-                num_slots, self.num_classes, grid=layout_grid, initial_weights=layout_weights
+                num_slots,
+                self.num_classes,
+                grid=layout_grid,
+                initial_weights=layout_weights,
+                sketch_dim=layout_sketch,
             )
             self.layout_weight = nn.Parameter(torch.ones(()))  # lambda
             self.out_dim += self.layout.out_dim
@@ -251,6 +258,7 @@ class SeanNet(nn.Module):
                 f"batch has M = {batch.num_slots} slots, the model {self.num_slots}; build the "
                 f"model with num_slots={batch.num_slots} or fix the dataset's slot table"
             )
+        adjacency = batch.adjacency  # sparse in a compact batch: the GCN reads its edges
         batch = batch.prepare()
         batch.validate(num_classes=self.num_classes)
         c4 = self.backbone(batch.images)
@@ -263,7 +271,13 @@ class SeanNet(nn.Module):
                 x = self.object_features(c4, batch, c5)
             else:
                 x = c4.new_zeros(0, self.objects.out_dim)
-            graph = self.gcn(self.node_features(x, batch), batch.adjacency.to(c4.dtype))
+            graph = self.gcn.forward_nodes(
+                x,
+                batch.box_view,
+                batch.slots,
+                adjacency.to(c4.dtype),
+                num_views=batch.num_views,
+            )
             parts.append(self.graph_norm(graph))
         fused = self.fusion(torch.cat(parts, dim=1))
         if self.layout is None:
@@ -301,7 +315,8 @@ def build_model(
     pretrained_sha256: str | None = None,
     visual_features: str = "c5",
     backbone: str = "resnet",
-    layout_grid: int = 8,
+    layout_grid: int = 32,
+    layout_sketch: int = 16384,
 ) -> SeanNet | ImageEncoder:
     """SeanNet or an image baseline by name; every model has ``embed(batch) -> (B, D)``.
 
@@ -322,6 +337,7 @@ def build_model(
         visual_features: how SeanNet computes :math:`x_v` (see :class:`SeanNet`).
         backbone: SeanNet's image network (see :class:`SeanNet`).
         layout_grid: SeanNet's layout pathway (see :class:`SeanNet`; 0 = off).
+        layout_sketch: its count-sketch width (see :class:`SeanNet`; 0 = unsketched).
 
     Raises:
         ModelError: an unknown name or a bad hyper-parameter or weights file.
@@ -359,5 +375,10 @@ def build_model(
         pretrained_sha256=pretrained_sha256,
         visual_features=visual_features,
         layout_weights=layout_weights,
-        **{"backbone": backbone, "layout_grid": layout_grid, **ABLATIONS.get(name, {})},
+        **{
+            "backbone": backbone,
+            "layout_grid": layout_grid,
+            "layout_sketch": layout_sketch,
+            **ABLATIONS.get(name, {}),
+        },
     )

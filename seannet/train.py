@@ -79,6 +79,7 @@ def build_for_dataset(  # noqa: ANN201
         visual_features=config.visual_features,
         backbone=config.backbone,
         layout_grid=config.layout_grid,
+        layout_sketch=config.layout_sketch,
     )
 
 

@@ -11,7 +11,7 @@ import pytest
 import torch
 
 from seannet.backbones import LITE0_WEIGHTS
-from seannet.compare import calibrate_batches, compare_models, model_spec
+from seannet.compare import calibrate_batches, compare_models, model_spec, paired_difference
 from seannet.config import TrainConfig
 from seannet.errors import ModelError
 from seannet.train import build_for_dataset as compare_build
@@ -50,7 +50,27 @@ def test_compare_sweeps_lr_and_summarises_seeds(tmp_path: Path, mini_dataset: Pa
         assert set(summary["by_moved"]) == {"0", "1-2", "3-5", "6+"}
         # the chosen lr's seed-0 run is the sweep's: seeds reuse it
         assert (out / entry["model"] / f"lr{entry['lr']:g}" / "seed1" / "best.pt").exists()
-    assert "| resnet18 |" in (out / "comparison.md").read_text()
+    table = (out / "comparison.md").read_text()
+    assert "| resnet18 |" in table
+    difference = saved["models"][1]["difference_to_first"]
+    assert difference["low"] <= difference["mean"] <= difference["high"]
+    assert f"- seannet-graph: {100 * difference['mean']:+.1f} points" in table
+
+
+def test_paired_difference_weights_rooms_and_brackets_the_gap() -> None:
+    def runs(*per_room: dict[str, float]) -> list[dict]:
+        return [{"per_room": rooms} for rooms in per_room]
+
+    counts = {"a": 10, "b": 30, "c": 20}
+    better = runs({"a": 1.0, "b": 0.6, "c": 0.9}, {"a": 0.8, "b": 0.6, "c": 0.7})
+    worse = runs({"a": 0.5, "b": 0.5, "c": 0.5})
+    d = paired_difference(better, worse, counts)
+    # seeds averaged per room (0.9, 0.6, 0.8), minus 0.5, weighted 10 / 30 / 20
+    assert d["mean"] == pytest.approx((0.4 * 10 + 0.1 * 30 + 0.3 * 20) / 60)
+    assert 0.0 < d["low"] < d["mean"] < d["high"] <= 0.4 and d["rooms"] == 3
+    same = paired_difference(worse, worse, counts)
+    assert same["mean"] == same["low"] == same["high"] == 0.0
+    assert paired_difference(better, worse, counts) == d  # a fixed resampling seed
 
 
 def test_budget_buys_batches(mini_dataset: Path) -> None:

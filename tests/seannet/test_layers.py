@@ -194,3 +194,87 @@ def test_slot_layout_compares_the_same_objects_boxes() -> None:
     assert grad[1] > 0 and grad[0] == 0 and grad[2] == 0  # only the class in view learns
     with pytest.raises(ModelError, match="grid=0"):
         SlotLayout(4, 2, grid=0)
+
+
+def test_sketched_slot_layout_keeps_the_dot_products() -> None:
+    """The count sketch keeps every pair's similarity within its standard error, draws the
+    same hash every time and saves it with the model."""
+    g = torch.Generator().manual_seed(0)
+    views, per_view, dim = 40, 12, 4096
+    corner = torch.rand(10, per_view, 2, generator=g) * 48  # 10 scenes, each seen 4 times
+    size = 4 + torch.rand(10, per_view, 2, generator=g) * 12
+    jitter = torch.rand(views, per_view, 2, generator=g) * 4
+    corner = corner.repeat(4, 1, 1) + jitter
+    boxes = torch.cat((corner, corner + size.repeat(4, 1, 1)), 2).flatten(0, 1)
+    args = dict(
+        box_view=torch.arange(views).repeat_interleave(per_view),
+        slots=torch.cat([torch.randperm(20, generator=g)[:per_view] for _ in range(10)] * 4),
+        class_ids=torch.zeros(views * per_view, dtype=torch.long),
+        num_views=views,
+        height=64,
+        width=64,
+    )
+    exact = F.normalize(SlotLayout(20, 1, grid=16)(boxes, **args), dim=1)
+    sketch = SlotLayout(20, 1, grid=16, sketch_dim=dim)
+    approx = F.normalize(sketch(boxes, **args), dim=1)
+    assert approx.shape == (views, dim) and sketch.out_dim == dim
+    error = (approx @ approx.T - exact @ exact.T).abs()
+    assert error.mean() < (2 / dim) ** 0.5 and error.max() < 5 * (2 / dim) ** 0.5
+    assert (exact @ exact.T).fill_diagonal_(0).max() > 0.5  # the views do share boxes
+    again = SlotLayout(20, 1, grid=16, sketch_dim=dim)
+    assert torch.equal(again.sketch_bucket, sketch.sketch_bucket)
+    assert {"sketch_bucket", "sketch_sign"} <= set(sketch.state_dict())
+    with pytest.raises(ModelError, match="sketch_dim=-1"):
+        SlotLayout(4, 2, sketch_dim=-1)
+
+
+def _graph_batch(seed: int) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
+    """Present nodes (box_view, slots), their features and a row-normalised (B, 3, M, M)
+    adjacency with edges among each view's present nodes only."""
+    g = torch.Generator().manual_seed(seed)
+    b, m = 3, 12
+    box_view = torch.tensor([0, 0, 0, 1, 1, 2, 2, 2, 2])
+    slots = torch.tensor([1, 4, 7, 0, 11, 2, 3, 5, 9])
+    x = torch.randn(len(slots), 32, generator=g)
+    a = torch.zeros(b, 3, m, m)
+    for v in range(b):
+        s = slots[box_view == v]
+        mask = torch.rand(3, len(s), len(s), generator=g) < 0.5
+        a[v][:, s.unsqueeze(1), s.unsqueeze(0)] = mask * (torch.rand(mask.shape, generator=g) + 0.1)
+    return box_view, slots, x, _row_normalised(a)
+
+
+@pytest.mark.parametrize("sparse", [False, True])
+def test_gcn_on_present_nodes_equals_the_dense_form(sparse: bool) -> None:
+    torch.manual_seed(0)
+    gcn = MultiPathwayGCN(num_slots=12, dims=(32, 16, 8, 4), hidden_dim=20, out_dim=10).eval()
+    box_view, slots, x, a = _graph_batch(0)
+    dense_x = torch.zeros(3, 12, 32).index_put((box_view, slots), x)
+    adjacency = a.to_sparse() if sparse else a
+    out = gcn.forward_nodes(x, box_view, slots, adjacency, num_views=3)
+    torch.testing.assert_close(out, gcn(dense_x, a))
+    assert out.abs().sum() > 0
+
+
+def test_gcn_on_present_nodes_learns_every_pathway() -> None:
+    torch.manual_seed(0)
+    gcn = MultiPathwayGCN(num_slots=12, dims=(32, 16, 8, 4), hidden_dim=20, out_dim=10).train()
+    box_view, slots, x, a = _graph_batch(1)
+    x.requires_grad_(True)
+    gcn.forward_nodes(x, box_view, slots, a, num_views=3).sum().backward()
+    assert x.grad is not None and x.grad.abs().sum() > 0
+    for pathway in gcn.pathways:
+        assert all(layer.weight.grad.abs().sum() > 0 for layer in pathway.layers)
+
+
+def test_gcn_on_present_nodes_ignores_edges_of_empty_slots_and_checks_shapes() -> None:
+    gcn = MultiPathwayGCN(num_slots=12, dims=(32, 16, 8, 4), hidden_dim=20, out_dim=10).eval()
+    box_view, slots, x, a = _graph_batch(2)
+    stray = a.clone()
+    stray[0, 2, 1, 6] = 0.5  # slot 6 of view 0 holds no node
+    torch.testing.assert_close(
+        gcn.forward_nodes(x, box_view, slots, stray, num_views=3),
+        gcn.forward_nodes(x, box_view, slots, a, num_views=3),
+    )
+    with pytest.raises(ModelError, match="expected"):
+        gcn.forward_nodes(x, box_view, slots, a[:, :2], num_views=3)
