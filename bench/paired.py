@@ -33,7 +33,9 @@ def main() -> None:
     parser.add_argument("b")
     parser.add_argument("--split", default="test")
     args = parser.parse_args()
-    d = paired_difference(runs_of(args.a), runs_of(args.b), triplets_per_room(args.data, args.split))
+    d = paired_difference(
+        runs_of(args.a), runs_of(args.b), triplets_per_room(args.data, args.split)
+    )
     print(
         f"{args.a} minus {args.b}: {100 * d['mean']:+.1f} points, 95 % room-bootstrap "
         f"[{100 * d['low']:+.1f}, {100 * d['high']:+.1f}] over {d['rooms']} rooms"
