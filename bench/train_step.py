@@ -15,6 +15,8 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import torch
@@ -67,7 +69,29 @@ def main() -> None:
         print(f"{name:9s} training step, batch {config.batch_size}: {figures[name]:.3f} s")
         if isinstance(model, SeanNet):
             graph_forms(model, batches[0][0], args.steps)
+            with dense_gcn(model):
+                dense_step = seconds_per_call(step, args.steps)
+            print(
+                f"  the same step with the dense GCN: {dense_step:.3f} s "
+                f"({dense_step / figures[name]:.2f}x the present-nodes step)"
+            )
     print(f"seannet / resnet18 step: {figures['seannet'] / figures['resnet18']:.2f}x")
+
+
+@contextmanager
+def dense_gcn(model: SeanNet) -> Iterator[None]:
+    """SeanNet's steps with the paper's dense GCN form (B x M slots) in place of the nodes'."""
+    gcn = model.gcn
+
+    def dense(x, box_view, slots, adjacency, *, num_views):
+        grid = x.new_zeros(num_views, gcn.num_slots, x.shape[1]).index_put((box_view, slots), x)
+        return gcn(grid, adjacency.to_dense() if adjacency.is_sparse else adjacency)
+
+    gcn.forward_nodes = dense
+    try:
+        yield
+    finally:
+        del gcn.forward_nodes
 
 
 def graph_forms(model: SeanNet, views, calls: int) -> None:

@@ -15,7 +15,7 @@ __all__ = ["GCNLayer", "GCNPathway", "MultiPathwayGCN", "NodeEdges"]
 
 
 class NodeEdges(NamedTuple):
-    """One relation's normalised adjacency as an edge list over present nodes.
+    r"""One relation's normalised adjacency as an edge list over present nodes.
 
     ``weight[e]`` is :math:`\hat{A}_{ij}` for the edge from node ``target[e]`` (i, the row)
     to ``source[e]`` (j); node ids index the (K, F) list of present nodes.
@@ -47,6 +47,9 @@ class GCNLayer(nn.Module):
         - **x**: :math:`(B, M, F_{in})` node features
         - **adjacency**: :math:`(B, M, M)` normalised adjacency :math:`\hat{A}`
         - **output**: :math:`(B, M, F_{out})`
+
+        or, on present nodes only: **x** :math:`(K, F_{in})`, **adjacency** a
+        :class:`NodeEdges`, **output** :math:`(K, F_{out})`.
     """
 
     def __init__(self, in_dim: int, out_dim: int, *, bias: bool = False) -> None:
@@ -65,19 +68,15 @@ class GCNLayer(nn.Module):
         if self.bias is not None:
             nn.init.zeros_(self.bias)
 
-    def forward(self, x: Tensor, adjacency: Tensor) -> Tensor:
+    def forward(self, x: Tensor, adjacency: Tensor | NodeEdges) -> Tensor:
         # (A X) W or A (X W): multiply by W first, it shrinks the width (512 -> 256 -> 64 -> 8)
-        out = adjacency @ (x @ self.weight)
-        if self.bias is not None:
-            out = out + self.bias
-        return out
-
-    def forward_nodes(self, x: Tensor, edges: NodeEdges) -> Tensor:
-        """The same product on present nodes only: (K, F_in) -> (K, F_out)."""
         h = x @ self.weight
-        out = h.new_zeros(h.shape).index_add_(
-            0, edges.target, h[edges.source] * edges.weight.unsqueeze(1)
-        )
+        if isinstance(adjacency, NodeEdges):  # present nodes only: (K, F) and an edge list
+            out = h.new_zeros(h.shape).index_add_(
+                0, adjacency.target, h[adjacency.source] * adjacency.weight.unsqueeze(1)
+            )
+        else:
+            out = adjacency @ h
         if self.bias is not None:
             out = out + self.bias
         return out
@@ -103,6 +102,8 @@ class GCNPathway(nn.Module):
         - **x**: :math:`(B, M, \text{dims}[0])`
         - **adjacency**: :math:`(B, M, M)`
         - **output**: :math:`(B, M, \text{dims}[-1])`
+
+        or (K, dims[0]) present nodes with a :class:`NodeEdges` -> (K, dims[-1]).
     """
 
     def __init__(self, dims: Sequence[int] = (512, 256, 64, 8), *, dropout: float = 0.2) -> None:
@@ -120,15 +121,9 @@ class GCNPathway(nn.Module):
         for layer in self.layers:
             layer.reset_parameters()
 
-    def forward(self, x: Tensor, adjacency: Tensor) -> Tensor:
+    def forward(self, x: Tensor, adjacency: Tensor | NodeEdges) -> Tensor:
         for layer in self.layers:
             x = torch.relu(layer(self.dropout(x), adjacency))
-        return x
-
-    def forward_nodes(self, x: Tensor, edges: NodeEdges) -> Tensor:
-        """The pathway on present nodes only: (K, dims[0]) -> (K, dims[-1])."""
-        for layer in self.layers:
-            x = torch.relu(layer.forward_nodes(self.dropout(x), edges))
         return x
 
 
@@ -214,7 +209,7 @@ class MultiPathwayGCN(nn.Module):
     def forward_nodes(
         self, x: Tensor, box_view: Tensor, slots: Tensor, adjacency: Tensor, *, num_views: int
     ) -> Tensor:
-        """:meth:`forward` computed on the present nodes only, the same function.
+        r""":meth:`forward` computed on the present nodes only, the same function.
 
         A view fills ~10-30 of its M slots: the dense form multiplies and drops out
         B x M rows that stay zero (two thirds of a CPU SeanNet step at M = 256); here the
@@ -240,7 +235,7 @@ class MultiPathwayGCN(nn.Module):
         edges = self._node_edges(box_view, slots, adjacency, num_views)
         flat = []
         for p, rel_edges in zip(self.pathways, edges, strict=True):
-            out = p.forward_nodes(x, rel_edges)
+            out = p(x, rel_edges)
             grid = out.new_zeros(num_views, m, out.shape[1])
             flat.append(grid.index_put((box_view, slots), out).flatten(1))
         return self.fc(torch.cat(flat, dim=1))

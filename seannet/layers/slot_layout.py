@@ -122,8 +122,8 @@ class SlotLayout(nn.Module):
         if not self.sketch_dim:
             out = rows.new_zeros(num_views, self.num_slots, self.grid * self.grid)
             return out.index_put((box_view, slots), rows).flatten(1)
-        cells = rows.shape[1]
-        coordinate = slots.unsqueeze(1) * cells + torch.arange(cells, device=rows.device)
+        per_slot = rows.shape[1]
+        coordinate = slots.unsqueeze(1) * per_slot + torch.arange(per_slot, device=rows.device)
         target = box_view.unsqueeze(1) * self.sketch_dim + self.sketch_bucket[coordinate]
         out = rows.new_zeros(num_views * self.sketch_dim)
         out = out.index_add(0, target.flatten(), (rows * self.sketch_sign[coordinate]).flatten())

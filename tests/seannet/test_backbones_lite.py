@@ -167,7 +167,7 @@ def test_seannet_on_the_lite0_backbone_embeds_and_normalises_its_way() -> None:
     )
     with torch.no_grad():
         out = model.embed(batch)
-    assert out.shape == (2, 64 + 16 * 64) and torch.isfinite(out).all()  # fused + layout
+    assert out.shape == (2, 64 + model.layout.out_dim) and torch.isfinite(out).all()  # + layout
     config = TrainConfig(backbone="efficientnet_lite0")
     transform = ImageTransform.for_model(112, config.image_family)
     assert transform.mean == LITE0_MEAN

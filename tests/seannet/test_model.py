@@ -165,11 +165,17 @@ def test_without_the_layout_pathway_the_graph_branch_is_the_papers() -> None:
     with torch.no_grad():
         assert net.embed(_batch((2,))).shape == (1, 2048)
     # checkpoints from before the layout pathway stored no layout_grid: they had none
-    legacy = {k: v for k, v in TrainConfig().to_dict().items() if k != "layout_grid"}
+    legacy = {k: v for k, v in TrainConfig().to_dict().items() if not k.startswith("layout_")}
     assert TrainConfig.from_dict(legacy).layout_grid == 0
+    # those from before the sketch had an unsketched grid: they load as they were trained
+    unsketched = TrainConfig(layout_grid=8).to_dict()
+    del unsketched["layout_sketch"]
+    assert TrainConfig.from_dict(unsketched).layout_sketch == 0
+    assert TrainConfig.from_dict(unsketched).layout_grid == 8
     assert TrainConfig.from_dict(TrainConfig().to_dict()) == TrainConfig()
-    with pytest.raises(ModelError, match="layout_grid"):
-        TrainConfig(layout_grid=-1)
+    for field in ("layout_grid", "layout_sketch"):
+        with pytest.raises(ModelError, match=field):
+            TrainConfig(**{field: -1})
 
 
 def test_batch_checks(model: SeanNet) -> None:
