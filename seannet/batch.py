@@ -171,18 +171,22 @@ class SceneBatch:
         assert self.mean is not None and self.std is not None  # checked on construction
         return normalise_pixels(self.images, self.mean, self.std)
 
-    def prepare(self, device: torch.device | str | None = None) -> SceneBatch:
+    def prepare(
+        self, device: torch.device | str | None = None, *, dense_adjacency: bool = True
+    ) -> SceneBatch:
         """The batch as the models consume it: normalised float32 images, dense adjacency.
 
         Moves the batch to ``device`` first (default: where it is), so the conversion runs
         there (on the GPU when training on one); a prepared batch is returned as it is.
+        ``dense_adjacency=False`` leaves a sparse adjacency sparse (SeanNet reads its edges:
+        densifying would fill B x 3 x M x M cells for nothing).
         """
         batch = self if device is None else self.to(device)
-        if batch.prepared:
-            return batch
         adjacency = batch.adjacency
-        if adjacency.layout == torch.sparse_coo:
+        if dense_adjacency and adjacency.layout == torch.sparse_coo:
             adjacency = adjacency.to_dense()
+        if batch.images.dtype != torch.uint8 and adjacency is batch.adjacency:
+            return batch
         return replace(
             batch, images=batch.normalised_images(), adjacency=adjacency, mean=None, std=None
         )

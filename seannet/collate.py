@@ -3,8 +3,8 @@
 A view travels from the datasets to the model in the compact form of ``SceneBatch``: its
 pixels as the uint8 the image cache (or the PNG decoder and the resize) gives, its adjacency
 as the sparse edge list :func:`~seannet.view_inputs.graph_from_columns` gives. The models
-normalise and densify on their own device (``SceneBatch.prepare``), so the loader does no
-float work and copies each view's pixels once.
+normalise on their own device (``SceneBatch.prepare``; SeanNet's GCN reads the edges as they
+are), so the loader does no float work and copies each view's pixels once.
 
 The datasets read a whole batch at once (``__getitems__``, which ``DataLoader`` calls): they
 gather its views straight into one :class:`ViewArrays`, and hand it over as a

@@ -246,8 +246,8 @@ class SeanNet(nn.Module):
         """Scene embeddings (B, embed_dim) of a batch.
 
         A compact batch (the loaders') is prepared first (:meth:`SceneBatch.prepare`: images
-        normalised, adjacency made dense) where it is, so on the model's device after
-        ``batch.to(device)``.
+        normalised; a sparse adjacency stays sparse, the GCN reads its edges) where it is, so
+        on the model's device after ``batch.to(device)``.
 
         Raises:
             DataError: the batch's indices are out of range or two boxes share a node.
@@ -258,8 +258,7 @@ class SeanNet(nn.Module):
                 f"batch has M = {batch.num_slots} slots, the model {self.num_slots}; build the "
                 f"model with num_slots={batch.num_slots} or fix the dataset's slot table"
             )
-        adjacency = batch.adjacency  # sparse in a compact batch: the GCN reads its edges
-        batch = batch.prepare()
+        batch = batch.prepare(dense_adjacency=False)
         batch.validate(num_classes=self.num_classes)
         c4 = self.backbone(batch.images)
         c5 = self.head[0](c4)  # the 5th stage, shared by the image vector and x_v
@@ -275,7 +274,7 @@ class SeanNet(nn.Module):
                 x,
                 batch.box_view,
                 batch.slots,
-                adjacency.to(c4.dtype),
+                batch.adjacency.to(c4.dtype),
                 num_views=batch.num_views,
             )
             parts.append(self.graph_norm(graph))
