@@ -21,10 +21,11 @@ from torch.utils.data import DataLoader
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from seannet.config import preset  # noqa: E402
-from seannet.data import ImageTransform, TripletDataset, collate_triplets  # noqa: E402
-from seannet.loss import TripletLoss  # noqa: E402
-from seannet.train import build_for_dataset, param_groups  # noqa: E402
+from seannet.data.datasets import ImageTransform, TripletDataset, collate_triplets  # noqa: E402
+from seannet.model.loss import TripletLoss  # noqa: E402
+from seannet.training.config import preset  # noqa: E402
+from seannet.training.runs import build_for_dataset  # noqa: E402
+from seannet.training.train import param_groups  # noqa: E402
 from sgdata.seeds import init_seed  # noqa: E402
 
 PARTS = {
@@ -54,7 +55,9 @@ def main() -> None:
     start = {k: v.detach().clone() for k, v in model.named_parameters()}
     optimizer = torch.optim.SGD(param_groups(model, config), lr=config.lr, momentum=config.momentum)
     loss_fn = TripletLoss(margin=config.margin)
-    data = TripletDataset(args.data, "train", transform=ImageTransform(size=config.image_size))
+    data = TripletDataset(
+        args.data, "train", transform=ImageTransform(size=config.model.image_size)
+    )
     loader = DataLoader(
         data, batch_size=config.batch_size, shuffle=True, collate_fn=collate_triplets
     )

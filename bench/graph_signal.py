@@ -24,10 +24,13 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import seannet  # noqa: E402,F401  (imports torch's compiler stack first: see tests/conftest.py)
-from seannet.checkpoint import load_checkpoint  # noqa: E402
-from seannet.config import TrainConfig  # noqa: E402
-from seannet.evaluate import embed_split  # noqa: E402
-from seannet.train import build_for_dataset, device_for_run  # noqa: E402
+from seannet.evaluation.metrics import embed_split  # noqa: E402
+from seannet.training.config import TrainConfig  # noqa: E402
+from seannet.training.runs import (  # noqa: E402
+    build_for_dataset,
+    device_for_run,
+    load_checkpoint,  # noqa: E402
+)
 
 KEEP = {"static": {"static"}, "static+low": {"static", "low"}, "all": {"static", "low", "high"}}
 LAMBDAS = (0.1, 0.2, 0.5, 1.0, 2.0, 5.0)

@@ -7,7 +7,7 @@
 Two raw reads bound the two loader paths. The PNG bound reads the image column of every
 observation shard of the split once and decodes the three images of every triplet; the cache
 bound copies the three cached (S, S, 3) uint8 views of every triplet out of the memory-mapped
-image cache (:mod:`seannet.image_cache`). Neither resizes, normalises or builds graph tensors.
+image cache (:mod:`seannet.data.image_cache`). Neither resizes, normalises or builds graph tensors.
 The loader runs `DataLoader(TripletDataset, batch_size=8, collate_fn=collate_triplets)` with 0
 and 2 workers (persistent, so epochs after the first reuse the workers' shard caches), once
 decoding PNG and once with ``cache=True``; it prints the first (cold) epoch and the mean of the
@@ -43,8 +43,8 @@ sys.path.insert(0, str(ROOT))
 
 from torch.utils.data import DataLoader  # noqa: E402
 
-from seannet.data import ImageTransform, TripletDataset, collate_triplets  # noqa: E402
-from seannet.image_cache import open_image_cache  # noqa: E402
+from seannet.data.datasets import ImageTransform, TripletDataset, collate_triplets  # noqa: E402
+from seannet.data.image_cache import open_image_cache  # noqa: E402
 from sgdata.dataset import Dataset, decode_image  # noqa: E402
 
 

@@ -4,7 +4,8 @@
 
 For comparisons run apart (e.g. a new SeanNet against a baseline compared earlier on the same
 data): the triplet-accuracy difference with its 95 % room-bootstrap interval, as
-``seannet compare`` prints for the models of one run (``seannet.compare.paired_difference``).
+``seannet compare`` prints for the models of one run
+(``seannet.evaluation.compare.paired_difference``).
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from seannet.compare import COMPARISON, paired_difference, triplets_per_room  # noqa: E402
+from seannet.evaluation.compare import COMPARISON, paired_difference, triplets_per_room  # noqa: E402
 
 
 def runs_of(spec: str) -> list[dict]:

@@ -26,11 +26,11 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import seannet  # noqa: E402,F401  (imports torch's compiler stack first: see tests/conftest.py)
-from seannet.config import preset  # noqa: E402
-from seannet.data import ImageTransform, TripletDataset, collate_triplets  # noqa: E402
-from seannet.loss import TripletLoss  # noqa: E402
-from seannet.model import SeanNet  # noqa: E402
-from seannet.train import build_for_dataset  # noqa: E402
+from seannet.data.datasets import ImageTransform, TripletDataset, collate_triplets  # noqa: E402
+from seannet.model.loss import TripletLoss  # noqa: E402
+from seannet.model.seannet import SeanNet  # noqa: E402
+from seannet.training.config import preset  # noqa: E402
+from seannet.training.runs import build_for_dataset  # noqa: E402
 
 
 def seconds_per_call(fn, calls: int) -> float:
@@ -52,7 +52,7 @@ def main() -> None:
     for name in ("resnet18", "seannet"):
         config = preset(args.preset).replace(model=name)
         model = build_for_dataset(config, args.data).train()
-        transform = ImageTransform.for_model(config.image_size, config.image_family)
+        transform = ImageTransform.for_model(config.model.image_size, config.model.image_family)
         triplets = TripletDataset(args.data, "train", transform=transform, cache=True)
         loader = DataLoader(triplets, batch_size=config.batch_size, collate_fn=collate_triplets)
         batches = [next(iter(loader))[:3]]

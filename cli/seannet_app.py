@@ -56,8 +56,8 @@ def train(
     """Train a model with the triplet loss; validates every epoch, keeps the best checkpoint."""
     from rich.progress import Progress
 
-    from seannet.config import preset as load_preset
-    from seannet.train import train as run_training
+    from seannet.training.config import preset as load_preset
+    from seannet.training.train import train as run_training
 
     config = load_preset(preset).replace(model=model, seed=seed)
     if backbone:
@@ -80,7 +80,7 @@ def train(
             pretrained_sha256=pretrained_sha256,
             progress=show,
         )
-    table = Table(title=f"{config.model} on {data} -> {out}")
+    table = Table(title=f"{config.model.name} on {data} -> {out}")
     for column in ("epoch", "loss", "train acc", "val acc", "lr", "s"):
         table.add_column(column, justify="right")
     for r in results:
@@ -102,7 +102,7 @@ def evaluate(
     split: Annotated[str, typer.Option(help="Split to evaluate.")] = "test",
 ) -> None:
     """Triplet accuracy (overall, per room, per tier), similarity heat maps, threshold."""
-    from seannet.eval_run import evaluate_run
+    from seannet.evaluation.eval import evaluate_run
 
     result = evaluate_run(run, data, split=split)
     console.print((run / f"eval_{split}.md").read_text())
@@ -136,8 +136,8 @@ def compare(
     ] = None,
 ) -> None:
     """Train every model under one budget, pick its lr on val, repeat over seeds, one table."""
-    from seannet.compare import COMPARISON, compare_models
-    from seannet.config import preset as load_preset
+    from seannet.evaluation.compare import COMPARISON, compare_models
+    from seannet.training.config import preset as load_preset
 
     try:
         seed_list = [int(s) for s in seeds.split(",") if s.strip()]
@@ -173,7 +173,7 @@ def wordvectors(
     ),
 ) -> None:
     """Build the class -> word-vector table from an installed package or a GloVe text file."""
-    from seannet.wordvectors import write_word_vectors
+    from seannet.model.wordvectors import write_word_vectors
 
     write_word_vectors(output, source=source)
     console.print(f"wrote {output}")
@@ -199,9 +199,9 @@ def build_map(
     spacing: Annotated[int, typer.Option(help="Cells between map nodes (the authors: 2).")] = 2,
 ) -> None:
     """Build topological maps (rendered sub-nodes + the run's embeddings), reused if present."""
-    from seannet.data import open_dataset
-    from seannet.localizer import load_localizer
-    from seannet.maps import build_maps
+    from seannet.data.datasets import open_dataset
+    from seannet.navigation.localizer import load_localizer
+    from seannet.navigation.maps import build_maps
 
     rooms = room or list(open_dataset(data).rooms(split))
     localizer = load_localizer(run, data, require_epsilon=False)  # a map needs no epsilon
@@ -224,7 +224,7 @@ def localize(
     out: Annotated[Path | None, typer.Option(help="Where to write (default: the run).")] = None,
 ) -> None:
     """Best-matching map sub-nodes of queries, or recall@1/@5 on a split (other layouts)."""
-    from seannet.localize import run_localize
+    from seannet.navigation.localize import run_localize
 
     result = run_localize(
         run, map_path, data, queries=queries or None, split=split, epsilon=epsilon, out=out
@@ -251,8 +251,8 @@ def train_navigator_command(
     """Train the visual navigator (forward / left / right) on pairs rendered from the rooms."""
     from rich.progress import Progress
 
-    from seannet.navigator import NavigatorConfig
-    from seannet.navigator_train import train_navigator
+    from seannet.navigation.navigator import NavigatorConfig
+    from seannet.navigation.train_navigator import train_navigator
 
     config = NavigatorConfig(
         encoder=encoder, image_size=image_size, epochs=epochs, batch_size=batch_size,
@@ -292,7 +292,7 @@ def navigate(
     strips: Annotated[Path | None, typer.Option(help="Save a few episodes as strips.")] = None,
 ) -> None:
     """The navigation test (paper Table II): success and failure rates, N / A, per localizer."""
-    from seannet.navigate_run import HEADER, run_navigation, table_rows
+    from seannet.navigation.navigate import HEADER, run_navigation, table_rows
 
     with console.status("navigate") as status:
         result = run_navigation(

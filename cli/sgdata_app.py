@@ -116,7 +116,8 @@ def preview(
     ] = False,
 ) -> None:
     """Write a top-down picture of a room or layout with class labels."""
-    from sgdata.pictures.preview import draw_layout_pair, draw_room, save_png
+    from sgdata.fileio import save_png
+    from sgdata.pictures.preview import draw_layout_pair, draw_room
     from sgdata.usd.room_io import read_room
 
     room = read_room(stage)
@@ -246,8 +247,8 @@ def render(
     from PIL import Image
 
     from sgdata.errors import ConfigError
+    from sgdata.fileio import save_png
     from sgdata.pictures.overlay import draw_overlay
-    from sgdata.pictures.preview import save_png
     from sgdata.pipeline.snapshot import render_snapshot
 
     cell, heading = None, 0

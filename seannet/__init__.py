@@ -1,67 +1,40 @@
-"""SeanNet: the scene-embedding network and its trainer (PyTorch side)."""
+"""SeanNet: the scene-embedding network, its trainer and its uses (the PyTorch side).
 
-from seannet.backbones import ENCODER_NAMES, ResNetSplit, image_encoder, resnet_c4
-from seannet.baselines import ImageEncoder
-from seannet.batch import NUM_RELATIONS, SceneBatch
-from seannet.config import PRESETS, TrainConfig, preset
-from seannet.data import (
-    ImageTransform,
-    ObservationDataset,
-    TripletDataset,
-    collate_triplets,
-    collate_views,
-    dataset_identity,
-)
-from seannet.errors import CheckpointError, DataError, ModelError, SeannetError
-from seannet.eval_run import evaluate_run
-from seannet.loss import TripletLoss, similarity
-from seannet.model import MODEL_NAMES, SeanNet, build_model
-from seannet.pretrained import KNOWN_WEIGHTS, load_pretrained, load_state_dict_file
-from seannet.train import train
-from seannet.wordvectors import (
-    WordVectorTable,
-    build_table,
-    load_table,
-    save_table,
-    split_camel_case,
-    write_word_vectors,
-)
+Laid out by stage, imports going downwards only (docs/architecture.md): ``data`` (views and
+triplets as tensors) < ``model`` (SeanNet, baselines, layers, loss) < ``training`` (config,
+the one training loop, run directories) < ``evaluation`` (metrics, ``seannet eval``,
+``compare``) < ``navigation`` (maps, localization, the navigator and its test). This face
+re-exports the most used names lazily: ``import seannet`` loads no torch.
+"""
 
-__all__ = [
-    "ImageTransform",
-    "ObservationDataset",
-    "PRESETS",
-    "TrainConfig",
-    "TripletDataset",
-    "collate_triplets",
-    "collate_views",
-    "dataset_identity",
-    "evaluate_run",
-    "preset",
-    "train",
-    "CheckpointError",
-    "DataError",
-    "ENCODER_NAMES",
-    "ImageEncoder",
-    "KNOWN_WEIGHTS",
-    "MODEL_NAMES",
-    "ModelError",
-    "NUM_RELATIONS",
-    "ResNetSplit",
-    "SceneBatch",
-    "SeanNet",
-    "SeannetError",
-    "TripletLoss",
-    "WordVectorTable",
-    "build_model",
-    "build_table",
-    "image_encoder",
-    "load_pretrained",
-    "load_state_dict_file",
-    "load_table",
-    "resnet_c4",
-    "save_table",
-    "similarity",
-    "split_camel_case",
-    "write_word_vectors",
-]
+from sgdata.lazy_face import lazy_face
+
+_EXPORTS = {
+    "CheckpointError": ".errors",
+    "DataError": ".errors",
+    "ModelError": ".errors",
+    "SeannetError": ".errors",
+    "ImageTransform": ".data",
+    "ObservationDataset": ".data",
+    "SceneBatch": ".data",
+    "TripletDataset": ".data",
+    "collate_triplets": ".data",
+    "collate_views": ".data",
+    "dataset_identity": ".data",
+    "MODEL_NAMES": ".model",
+    "ImageEncoder": ".model",
+    "ModelConfig": ".model",
+    "SeanNet": ".model",
+    "TripletLoss": ".model",
+    "build_model": ".model",
+    "similarity": ".model",
+    "PRESETS": ".training",
+    "TrainConfig": ".training",
+    "preset": ".training",
+    "train": ".training",
+    "evaluate_run": ".evaluation",
+    "compare_models": ".evaluation",
+}
+
+__all__ = sorted(_EXPORTS)
+__getattr__, __dir__ = lazy_face(__name__, _EXPORTS)

@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import io
 import os
 import tempfile
 from pathlib import Path
+
+from PIL import Image
 
 from sgdata.errors import ConfigError
 
@@ -14,6 +17,7 @@ __all__ = [
     "atomic_write_text",
     "prepare_output_dir",
     "remove_stale_temps",
+    "save_png",
 ]
 
 # Temporary files of atomic writes: ".<name>.<random>.tmp" beside the target.
@@ -61,3 +65,10 @@ def remove_stale_temps(root: Path) -> int:
 def atomic_write_text(path: Path, text: str) -> None:
     """Write UTF-8 ``text`` atomically."""
     atomic_write_bytes(path, text.encode("utf-8"))
+
+
+def save_png(image: Image.Image, path: Path) -> None:
+    """Write a PIL image as PNG atomically (temp file + rename)."""
+    buffer = io.BytesIO()
+    image.save(buffer, format="PNG")
+    atomic_write_bytes(path, buffer.getvalue())

@@ -2,16 +2,12 @@
 
 from __future__ import annotations
 
-import io
-from pathlib import Path
-
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
-from sgdata.fileio import atomic_write_bytes
 from sgdata.world.scene import Room, SceneObject
 
-__all__ = ["draw_room", "draw_layout_pair", "save_png"]
+__all__ = ["draw_room", "draw_layout_pair"]
 
 PIXELS_PER_METRE = 140
 MARGIN = 40
@@ -86,13 +82,6 @@ def draw_layout_pair(base: Room, layout: Room, *, title: str = "layout") -> Imag
     pair.paste(left, (0, 0))
     pair.paste(right, (left.width + 10, 0))
     return pair
-
-
-def save_png(image: Image.Image, path: Path) -> None:
-    """Write a PNG atomically (temp file + rename)."""
-    buffer = io.BytesIO()
-    image.save(buffer, format="PNG")
-    atomic_write_bytes(path, buffer.getvalue())
 
 
 def _footprint(obj: SceneObject) -> np.ndarray:

@@ -1,5 +1,6 @@
-"""The house's layering (docs/architecture.md): stages import downwards only, no cycles, and
-the reading side loads no USD, renderer or torch."""
+"""The house's layering (docs/architecture.md): stages import downwards only, no cycles
+(imports inside functions count), seannet reaches only the sgdata it may, and the reading
+side loads no USD, renderer or torch."""
 
 from __future__ import annotations
 
@@ -23,18 +24,35 @@ STAGES = (
     "pipeline",
     "pictures",
 )
+# seannet's stages from the bottom up; its top-level modules (errors, weights: plain facts)
+# sit below them all
+SEANNET_STAGES = ("data", "model", "training", "evaluation", "navigation")
+# The sgdata a seannet module may import: the dataset and its vocabularies (classes, relation
+# types), seeds, atomic files, errors. Only the live views (rendering a dataset's rooms again)
+# reach the generator's stages.
+SEANNET_MAY_IMPORT = (
+    "sgdata.dataset",
+    "sgdata.seeds",
+    "sgdata.fileio",
+    "sgdata.errors",
+    "sgdata.scene_files",
+    "sgdata.lazy_face",
+    "sgdata.annotate.relations",  # the relation types: the dataset's own vocabulary
+    "sgdata.world.catalog",  # the class vocabulary when a model is built without a dataset
+)
+LIVE_VIEWS_MAY_IMPORT = ("sgdata.render", "sgdata.usd", "sgdata.annotate", "sgdata.world.poses")
 HEAVY = ("pxr", "pyrender", "open3d", "trimesh", "torch", "OpenGL", "sgdata.render", "sgdata.usd")
 
 
-def _imports(path: Path) -> set[str]:
-    """Every sgdata module a file imports, at module level or inside functions."""
+def _imports(path: Path, package: str = "sgdata") -> set[str]:
+    """Every ``package`` module a file imports, at module level or inside functions."""
     found = set()
     for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
         if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
             found.add(node.module)
         elif isinstance(node, ast.Import):
             found.update(a.name for a in node.names)
-    return {m for m in found if m == "sgdata" or m.startswith("sgdata.")}
+    return {m for m in found if m == package or m.startswith(package + ".")}
 
 
 def _stage(module: str) -> str | None:
@@ -42,9 +60,9 @@ def _stage(module: str) -> str | None:
     return parts[1] if len(parts) > 1 and parts[1] in STAGES else None
 
 
-def _modules() -> list[tuple[str, Path]]:
+def _modules(package: str = "sgdata") -> list[tuple[str, Path]]:
     out = []
-    for path in sorted((ROOT / "sgdata").rglob("*.py")):
+    for path in sorted((ROOT / package).rglob("*.py")):
         rel = path.relative_to(ROOT).with_suffix("")
         parts = list(rel.parts[:-1] if rel.name == "__init__" else rel.parts)
         out.append((".".join(parts), path))
@@ -73,22 +91,19 @@ def test_world_and_render_never_import_each_other_and_dataset_needs_no_usd() -> 
     assert wrong == []
 
 
-def test_no_module_level_import_cycle() -> None:
-    """Module-level imports (the ones that run at import time) form no cycle."""
+@pytest.mark.parametrize("package", ["sgdata", "seannet"])
+def test_no_import_cycle(package: str) -> None:
+    """No cycle among a package's modules, counting imports inside functions: a circle
+    closed by a deferred import is still a circle (each module needs the others)."""
+    names = {m for m, _ in _modules(package)}
     graph: dict[str, set[str]] = {}
-    names = {m for m, _ in _modules()}
-    for module, path in _modules():
-        tree = ast.parse(path.read_text(encoding="utf-8"))
-        deps = set()
-        for node in tree.body:
-            if isinstance(node, ast.ImportFrom) and node.module in names:
-                deps.add(node.module)
-        graph[module] = deps - {module}
+    for module, path in _modules(package):
+        graph[module] = {_owner(t, names) for t in _imports(path, package)} - {module, None}
     state: dict[str, int] = {}
 
     def visit(node: str, trail: list[str]) -> None:
         state[node] = 1
-        for nxt in graph.get(node, ()):
+        for nxt in sorted(graph.get(node, ())):
             if state.get(nxt) == 1:
                 pytest.fail("import cycle: " + " -> ".join([*trail, node, nxt]))
             if nxt not in state:
@@ -98,6 +113,45 @@ def test_no_module_level_import_cycle() -> None:
     for module in sorted(graph):
         if module not in state:
             visit(module, [])
+
+
+def _owner(target: str, names: set[str]) -> str | None:
+    """The module an import names: ``a.b.c`` itself, or the package ``a.b`` whose face
+    re-exports ``c``. A package's own face is left out: it only re-exports, lazily."""
+    while target and target not in names:
+        target = target.rpartition(".")[0]
+    return None if not target or target.count(".") == 0 else target
+
+
+def _seannet_stage(module: str) -> int:
+    parts = module.split(".")
+    if len(parts) > 1 and parts[1] in SEANNET_STAGES:
+        return SEANNET_STAGES.index(parts[1])
+    return -1  # seannet.errors, seannet.weights: below every stage
+
+
+def test_seannet_stages_import_downwards_only() -> None:
+    wrong = []
+    for module, path in _modules("seannet"):
+        if module == "seannet":
+            continue  # the face re-exports lazily from every stage
+        own = _seannet_stage(module)
+        for target in _imports(path, "seannet"):
+            if target != "seannet" and _seannet_stage(target) > own:
+                wrong.append(f"{module} imports {target}")
+    assert wrong == []
+
+
+def test_seannet_imports_only_the_sgdata_it_may() -> None:
+    wrong = []
+    for module, path in _modules("seannet"):
+        allowed = SEANNET_MAY_IMPORT
+        if module == "seannet.data.live_views":
+            allowed += LIVE_VIEWS_MAY_IMPORT
+        for target in _imports(path, "sgdata"):
+            if not any(target == a or target.startswith(a + ".") for a in allowed):
+                wrong.append(f"{module} imports {target}")
+    assert wrong == []
 
 
 def test_no_module_is_past_600_lines() -> None:
@@ -130,10 +184,34 @@ def test_the_reading_side_loads_no_usd_renderer_or_torch(statement: str) -> None
     assert [m for m in loaded if m.split(".")[0] in HEAVY or m.startswith(HEAVY)] == []
 
 
-def test_every_module_says_its_job_in_a_docstring() -> None:
+@pytest.mark.parametrize("package", ["sgdata", "seannet"])
+def test_every_module_says_its_job_in_a_docstring(package: str) -> None:
     missing = [
         str(path.relative_to(ROOT))
-        for _, path in _modules()
+        for _, path in _modules(package)
         if not ast.get_docstring(ast.parse(path.read_text(encoding="utf-8")))
     ]
     assert missing == []
+
+
+# seannet's faces are lazy: importing one loads torch only when a name that needs it is used,
+# and the data stage never loads torchvision's model code
+@pytest.mark.parametrize(
+    ("statement", "banned"),
+    [
+        ("import seannet", ("torch",)),
+        ("import seannet.data, seannet.model, seannet.training", ("torch",)),
+        ("import seannet.evaluation, seannet.navigation", ("torch",)),
+        ("from seannet.data import TripletDataset", ("torchvision.models", "seannet.model")),
+    ],
+)
+def test_seannet_faces_load_lazily(statement: str, banned: tuple[str, ...]) -> None:
+    code = f"import sys; {statement}; print(','.join(sorted(sys.modules)))"
+    loaded = (
+        subprocess.run(
+            [sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT
+        )
+        .stdout.strip()
+        .split(",")
+    )
+    assert [m for m in loaded if m in banned or m.startswith(tuple(b + "." for b in banned))] == []

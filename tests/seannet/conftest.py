@@ -6,11 +6,11 @@ from pathlib import Path
 
 import pytest
 
-from seannet.config import TrainConfig
-from seannet.train import train
+from seannet.training.config import TrainConfig
+from seannet.training.train import train
 
 # A localizer run in seconds: the ResNet-18 baseline at 64 px, one batch of two triplets.
-TINY_LOCALIZER = TrainConfig(
+TINY_LOCALIZER = TrainConfig().replace(
     model="resnet18",
     image_size=64,
     embed_dim=64,

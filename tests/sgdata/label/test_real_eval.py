@@ -48,12 +48,12 @@ def _real_dataset(tmp_path: Path) -> Path:
 
 
 def test_eval_runs_on_a_real_dataset(tmp_path: Path, mini_dataset: Path) -> None:
-    from seannet.config import TrainConfig
-    from seannet.eval_run import evaluate_run
-    from seannet.train import train
+    from seannet.evaluation.eval import evaluate_run
+    from seannet.training.config import TrainConfig
+    from seannet.training.train import train
 
     # tests/seannet/test_train.py's CPU settings, one epoch of 3 batches
-    fast = TrainConfig(
+    fast = TrainConfig().replace(
         depth=18,
         image_size=64,
         roi_size=4,

@@ -1,0 +1,17 @@
+"""Stage 5, navigation (paper §VI): motion on the grid, maps of views, the localizer and
+``seannet localize``, the visual navigator and its training, episodes and ``seannet navigate``."""
+
+from sgdata.lazy_face import lazy_face
+
+_EXPORTS = {
+    "Localizer": ".localizer",
+    "load_localizer": ".localizer",
+    "TopoMap": ".maps",
+    "build_maps": ".maps",
+    "NavigatorConfig": ".navigator",
+    "load_navigator": ".navigator",
+    "train_navigator": ".train_navigator",
+}
+
+__all__ = sorted(_EXPORTS)
+__getattr__, __dir__ = lazy_face(__name__, _EXPORTS)

@@ -1,0 +1,126 @@
+"""A trained run as a localizer: its model, its image size and its threshold epsilon.
+
+The paper's localizer (§V-D, §VI-B) says "same place" when S(current, goal) > epsilon. A run's
+epsilon is the one ``seannet eval`` chose on the validation split (``eval_<split>.json``,
+``threshold.epsilon``); ``--epsilon`` gives one where the run has not been evaluated.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+
+from seannet.data.datasets import ImageTransform, ViewTensors, collate_views
+from seannet.errors import NavigationError
+from seannet.model.pretrained import file_sha256
+from seannet.training.config import TrainConfig
+from seannet.training.loop import collect, embed_batch
+from seannet.training.runs import restore_run
+
+__all__ = ["Localizer", "load_localizer", "run_epsilon"]
+
+EVAL_SPLITS = ("val", "test")  # eval files searched for epsilon, in this order, then any other
+BATCH = 16  # views embedded per forward pass
+
+
+@dataclass
+class Localizer:
+    """A run ready to embed views (eval mode) and to judge "same place" by epsilon."""
+
+    run: Path
+    name: str  # the run's model name (seannet, resnet18, ...)
+    model: torch.nn.Module
+    config: TrainConfig
+    epsilon: float
+    epsilon_source: str  # the eval file it came from, or "--epsilon"
+    identity: dict[str, Any]  # the dataset the run was trained on
+    digest: str  # sha256 of the checkpoint: maps record it
+    device: torch.device
+
+    @property
+    def transform(self) -> ImageTransform:
+        """The run's image transform (its input size)."""
+        model = self.config.model
+        return ImageTransform.for_model(model.image_size, model.image_family)
+
+    def embed(self, views: Sequence[ViewTensors]) -> np.ndarray:
+        """Unit embeddings (N, D) float32 of views, in batches of 16."""
+        if not views:
+            return np.zeros((0, self.model.out_dim), dtype=np.float32)
+        batches = (
+            collate_views(list(views[start : start + BATCH]))
+            for start in range(0, len(views), BATCH)
+        )
+        vectors = collect(self.model, batches, embed_batch(self.model, self.device))
+        return vectors.numpy().astype(np.float32)
+
+
+def run_epsilon(run: Path) -> tuple[float, str] | None:
+    """The threshold ``seannet eval`` chose for ``run``, and the file it is read from.
+
+    ``eval_val.json``, then ``eval_test.json``, then any other ``eval_*.json``; files whose
+    epsilon is missing or NaN are skipped. None when no file has one.
+    """
+    names = [f"eval_{s}.json" for s in EVAL_SPLITS]
+    others = sorted(p.name for p in run.glob("eval_*.json") if p.name not in names)
+    for name in [*names, *others]:
+        path = run / name
+        if not path.is_file():
+            continue
+        try:
+            value = json.loads(path.read_text())["threshold"]["epsilon"]
+        except (ValueError, KeyError, TypeError):
+            continue
+        if isinstance(value, int | float) and math.isfinite(value):
+            return float(value), name
+    return None
+
+
+def load_localizer(
+    run: Path, data: Path, *, epsilon: float | None = None, require_epsilon: bool = True
+) -> Localizer:
+    """``run/best.pt`` on ``data`` (the dataset it was trained on) as a localizer.
+
+    Args:
+        run: the run directory.
+        data: the dataset the run was trained on.
+        epsilon: the threshold to use; None reads the run's eval files (:func:`run_epsilon`).
+        require_epsilon: without one, raise (True) or leave epsilon NaN (building maps).
+
+    Raises:
+        CheckpointError: no checkpoint, or it was trained on another dataset.
+        NavigationError: no epsilon given and the run has no evaluated threshold.
+    """
+    restored = restore_run(run, data)
+    if epsilon is None:
+        found = run_epsilon(run)
+        if found is None and not require_epsilon:
+            found = (float("nan"), "none")
+        if found is None:
+            raise NavigationError(
+                f"{run}: no eval_<split>.json with threshold.epsilon; run `seannet eval {run} "
+                f"--data {data} --split test` first, or pass --epsilon"
+            )
+        epsilon, source = found
+    else:
+        source = "--epsilon"
+    if require_epsilon and not math.isfinite(epsilon):
+        raise NavigationError(f"epsilon {epsilon}: expected a finite number")
+    return Localizer(
+        run=run,
+        name=restored.config.model.name,
+        model=restored.model,
+        config=restored.config,
+        epsilon=float(epsilon),
+        epsilon_source=source,
+        identity=restored.state["dataset"],
+        digest=file_sha256(restored.path),
+        device=restored.device,
+    )

@@ -1,0 +1,215 @@
+"""The visual navigator (paper §VI-B, after SPTM): forward / left / right from two views.
+
+The network and what it learns from: its config, the label rule and the draw of a training
+pair (the authors: goal within +-2 cells sideways and 0..4 cells forward of the current pose,
+same heading; the label is the larger displacement). Rendering pairs and training are in
+:mod:`seannet.navigation.train_navigator`; :class:`Policy` acts with a trained one.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+from torch import Tensor, nn
+
+from seannet.data.batch import normalise_pixels
+from seannet.data.view_inputs import ImageTransform
+from seannet.errors import CheckpointError, ModelError
+from seannet.model.backbones import ENCODER_NAMES, image_encoder
+from seannet.navigation.motion import FORWARD, HEADINGS, NAVIGATOR_ACTIONS, local_offset
+from seannet.training.runs import BEST, device_for_run, load_checkpoint
+from seannet.weights import IMAGENET_MEAN, IMAGENET_STD
+
+__all__ = [
+    "KIND",
+    "NavigatorConfig",
+    "Policy",
+    "VisualNavigator",
+    "draw_pair",
+    "label_for",
+    "load_navigator",
+    "navigator_inputs",
+    "resize",
+]
+
+KIND = "navigator"  # checkpoints say what they hold: a localizer run is refused here
+
+
+def resize(rgb: np.ndarray, size: int) -> np.ndarray:
+    """(H, W, 3) uint8 -> (size, size, 3) uint8, resampled as the localizers' views are."""
+    return ImageTransform(size).resize(rgb, _NO_BOXES)[0]
+
+
+def navigator_inputs(images: np.ndarray) -> Tensor:
+    """(B, S, S, 3) uint8 -> (B, 3, S, S) float32 normalised as every ImageNet network's."""
+    pixels = torch.from_numpy(np.array(images, dtype=np.uint8)).permute(0, 3, 1, 2)
+    return normalise_pixels(pixels, IMAGENET_MEAN, IMAGENET_STD)
+
+
+_NO_BOXES = np.zeros((0, 4), dtype=np.float32)
+
+
+@dataclass(frozen=True)
+class NavigatorConfig:
+    """Everything a navigator run depends on; stored in its checkpoints."""
+
+    encoder: str = "resnet18"  # torchvision encoder shared by both views (the paper: VGG-16)
+    image_size: int = 96  # square input (64..112 keeps a CPU run short)
+    hidden: int = 256  # MLP width after the concatenated features
+    epochs: int = 10
+    batch_size: int = 32
+    lr: float = 0.01  # SGD, as the authors
+    momentum: float = 0.9
+    train_pairs: int = 2000  # pairs rendered from the train rooms (all epochs reuse them)
+    val_pairs: int = 400  # from the val rooms: accuracy every epoch picks best.pt
+    max_side: int = 2  # goal within +-max_side cells sideways ...
+    max_forward: int = 4  # ... and 0..max_forward cells forward
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        if self.encoder not in ENCODER_NAMES:
+            raise ModelError(
+                f"navigator.encoder {self.encoder!r}: expected one of {', '.join(ENCODER_NAMES)}"
+            )
+        for name in ("image_size", "hidden", "epochs", "batch_size", "train_pairs"):
+            if getattr(self, name) < 1:
+                raise ModelError(f"navigator.{name} must be >= 1, got {getattr(self, name)}")
+        if self.image_size < 32:
+            raise ModelError(f"navigator.image_size {self.image_size}: expected >= 32 pixels")
+        if self.val_pairs < 0 or self.max_side < 0 or self.max_forward < 0:
+            raise ModelError("navigator: val_pairs, max_side and max_forward must be >= 0")
+        if self.max_side + self.max_forward < 1:
+            raise ModelError("navigator: max_side + max_forward must be >= 1 (a goal must move)")
+        if self.lr <= 0 or not 0 <= self.momentum < 1:
+            raise ModelError(f"navigator: lr {self.lr} must be > 0, momentum within [0, 1)")
+
+    def replace(self, **changes: Any) -> NavigatorConfig:
+        """A copy with some fields changed (validated again)."""
+        return dataclasses.replace(self, **changes)
+
+    def to_dict(self) -> dict[str, Any]:
+        return dataclasses.asdict(self)
+
+
+class VisualNavigator(nn.Module):
+    r"""A siamese classifier of the action that brings the current view towards the goal view.
+
+    After SPTM's locomotion network (Savinov et al., arXiv 1803.00653) as the paper uses it
+    (§VI-B): one image encoder shared by both views, the two feature vectors concatenated,
+    then ``Linear -> ReLU -> Linear`` to logits over
+    :data:`seannet.navigation.motion.NAVIGATOR_ACTIONS`
+    (forward, left, right: translations of one cell).
+
+    Args:
+        encoder: a name of :data:`seannet.model.backbones.ENCODER_NAMES` (default ``"resnet18"``).
+        hidden: MLP width (default 256).
+        pretrained: optional local ImageNet weights of ``encoder`` (SHA-256 checked).
+
+    Shapes:
+        - **current**, **goal**: :math:`(B, 3, S, S)` normalised images
+        - **output**: :math:`(B, 3)` logits
+    """
+
+    def __init__(
+        self, encoder: str = "resnet18", *, hidden: int = 256, pretrained: Path | None = None
+    ) -> None:
+        super().__init__()
+        self.encoder_name = encoder
+        self.encoder, width = image_encoder(encoder, pretrained=pretrained)
+        self.head = nn.Sequential(
+            nn.Linear(2 * width, hidden),
+            nn.ReLU(inplace=True),
+            nn.Linear(hidden, len(NAVIGATOR_ACTIONS)),
+        )
+
+    def forward(self, current: Tensor, goal: Tensor) -> Tensor:
+        if current.shape != goal.shape:
+            raise ModelError(
+                f"navigator views differ: {tuple(current.shape)} vs {tuple(goal.shape)}"
+            )
+        features = self.encoder(torch.cat([current, goal]))  # one pass, shared weights
+        a, b = features.chunk(2)
+        return self.head(torch.cat([a, b], dim=1))
+
+    def extra_repr(self) -> str:
+        return f"encoder={self.encoder_name!r}"
+
+
+def label_for(forward: int, side: int) -> int:
+    """The action index for a goal ``forward`` cells ahead and ``side`` cells to the left
+    (negative: right): the larger displacement wins, forward on a tie."""
+    if forward >= abs(side):
+        return NAVIGATOR_ACTIONS.index("forward")
+    return NAVIGATOR_ACTIONS.index("left" if side > 0 else "right")
+
+
+def draw_pair(
+    reachable: np.ndarray,
+    rng: np.random.Generator,
+    *,
+    max_side: int = 2,
+    max_forward: int = 4,
+    tries: int = 100,
+) -> tuple[tuple[int, int, int], tuple[int, int, int], int] | None:
+    """A (current, goal, label) draw on a reachable mask (None when ``tries`` draws fail).
+
+    The current pose is a reachable cell and a heading; the goal keeps the heading and lies
+    ``0..max_forward`` cells ahead and ``-max_side..max_side`` sideways, not on the same cell,
+    on a reachable cell.
+    """
+    cells = np.argwhere(reachable)
+    if not len(cells):
+        return None
+    nx, ny = reachable.shape
+    for _ in range(tries):
+        i, j = (int(v) for v in cells[rng.integers(len(cells))])
+        h = int(rng.integers(HEADINGS))
+        forward = int(rng.integers(0, max_forward + 1))
+        side = int(rng.integers(-max_side, max_side + 1))
+        if forward == 0 and side == 0:
+            continue
+        (fi, fj), (li, lj) = FORWARD[h], FORWARD[(h + 1) % HEADINGS]
+        gi, gj = i + forward * fi + side * li, j + forward * fj + side * lj
+        if 0 <= gi < nx and 0 <= gj < ny and reachable[gi, gj]:
+            assert local_offset((i, j, h), (gi, gj)) == (forward, side)
+            return (i, j, h), (gi, gj, h), label_for(forward, side)
+    return None
+
+
+class Policy:
+    """A trained navigator acting on RGB views: :meth:`act` gives an action name."""
+
+    def __init__(self, model: VisualNavigator, config: NavigatorConfig, device: torch.device):
+        self.model, self.config, self.device = model.eval(), config, device
+
+    @torch.no_grad()
+    def act(self, current: np.ndarray, goal: np.ndarray) -> str:
+        """The action (forward / left / right) from (H, W, 3) uint8 current and goal views."""
+        s = self.config.image_size
+        a = navigator_inputs(resize(current, s)[None]).to(self.device)
+        b = navigator_inputs(resize(goal, s)[None]).to(self.device)
+        return NAVIGATOR_ACTIONS[int(self.model(a, b).argmax(1)[0])]
+
+
+def load_navigator(run: Path) -> Policy:
+    """``run/best.pt`` of ``seannet train-navigator`` as a :class:`Policy`.
+
+    Raises:
+        CheckpointError: no checkpoint, or not a navigator's.
+    """
+    path = run / BEST
+    state = load_checkpoint(path)
+    if state.get("kind") != KIND:
+        raise CheckpointError(
+            f"{path}: not a navigator checkpoint (train one with train-navigator)"
+        )
+    config = NavigatorConfig(**state["config"])
+    device = device_for_run()
+    model = VisualNavigator(config.encoder, hidden=config.hidden).to(device)
+    model.load_state_dict(state["model"])
+    return Policy(model, config, device)

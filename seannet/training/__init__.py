@@ -1,0 +1,22 @@
+"""Stage 3, training: ``TrainConfig`` and its presets, the one training loop and the one
+evaluation loop, run directories (checkpoints, restoring a run), and ``train``."""
+
+from sgdata.lazy_face import lazy_face
+
+_EXPORTS = {
+    "PRESETS": ".config",
+    "TrainConfig": ".config",
+    "preset": ".config",
+    "collect": ".loop",
+    "train_one_epoch": ".loop",
+    "BEST": ".runs",
+    "HISTORY": ".runs",
+    "LAST": ".runs",
+    "build_for_dataset": ".runs",
+    "device_for_run": ".runs",
+    "restore_run": ".runs",
+    "train": ".train",
+}
+
+__all__ = sorted(_EXPORTS)
+__getattr__, __dir__ = lazy_face(__name__, _EXPORTS)

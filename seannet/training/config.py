@@ -1,0 +1,129 @@
+"""Training configuration: presets (``cpu``, ``gpu``, ``paper``) as frozen dataclasses."""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import Any
+
+from seannet.errors import ModelError
+from seannet.model.config import MODEL_FIELDS, ModelConfig
+
+__all__ = ["PRESETS", "TrainConfig", "preset"]
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    """Everything a training run depends on; stored in every checkpoint. The model's own
+    hyper-parameters live in :class:`~seannet.model.config.ModelConfig` (``model``)."""
+
+    model: ModelConfig = ModelConfig()
+    epochs: int = 60
+    batch_size: int = 14  # the paper's SeanNet batch
+    lr: float = 0.01  # SGD (paper §V-B)
+    # learning rate of the layers SeanNet adds (object fcn, GCN, fusion) relative to ``lr``
+    new_layers_lr_scale: float = 1.0
+    momentum: float = 0.9
+    lr_decay: float = 0.7  # x0.7 ...
+    decay_every: int = 10  # ... every 10 epochs
+    margin: float = 0.1  # triplet loss margin
+    num_workers: int = 2  # DataLoader workers
+    max_train_batches: int = 0  # per epoch; 0 = the whole split (a CPU budget knob)
+    max_val_triplets: int = 0  # validated per epoch, evenly spaced; 0 = the whole split
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.model, ModelConfig):
+            raise ModelError(f"train.model must be a ModelConfig, got {type(self.model).__name__}")
+        for name in ("epochs", "batch_size"):
+            if getattr(self, name) < 1:
+                raise ModelError(f"train.{name} must be >= 1, got {getattr(self, name)}")
+        if self.new_layers_lr_scale <= 0:
+            raise ModelError(
+                f"train.new_layers_lr_scale must be > 0, got {self.new_layers_lr_scale}"
+            )
+        if self.lr <= 0 or self.margin < 0 or self.decay_every < 1 or self.num_workers < 0:
+            raise ModelError("train: lr > 0, margin >= 0, decay_every >= 1, num_workers >= 0")
+
+    @classmethod
+    def from_dict(cls, raw: dict[str, Any]) -> TrainConfig:
+        """The config a checkpoint stored (:meth:`to_dict`). Checkpoints written before
+        ``ModelConfig`` held the model's fields at the top level with ``model`` its name;
+        those written before the layout pathway lack ``layout_grid`` (their models had none:
+        0), those written before its sketch lack ``layout_sketch`` (unsketched: 0)."""
+        raw = dict(raw)
+        model = raw.pop("model")
+        if isinstance(model, str):  # the flat form
+            legacy = {"layout_grid": 0, "layout_sketch": 0}
+            model = {
+                "name": model,
+                **legacy,
+                **{k: raw.pop(k) for k in list(raw) if k in MODEL_FIELDS},
+            }
+        return cls(model=ModelConfig(**model), **raw)
+
+    def replace(self, **changes: Any) -> TrainConfig:
+        """A copy with some fields changed (validated again). Fields of the model may be
+        given here too (``depth=18``); ``model`` takes a ModelConfig or a model name."""
+        model = changes.pop("model", self.model)
+        if isinstance(model, str):
+            model = self.model.replace(name=model)
+        model_changes = {k: changes.pop(k) for k in list(changes) if k in MODEL_FIELDS}
+        if model_changes:
+            model = model.replace(**model_changes)
+        return dataclasses.replace(self, model=model, **changes)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain form for checkpoints and reports."""
+        return dataclasses.asdict(self)
+
+
+PRESETS: dict[str, TrainConfig] = {
+    # The paper: ResNet-50 at 224 px, 60 epochs, SGD 0.01 x0.7 every 10 epochs, margin 0.1.
+    "paper": TrainConfig(),  # every default: ModelConfig's and the fields above
+    # Two CPU cores in about half an hour for SeanNet: ResNet-18 at 112 px (C4 7 x 7,
+    # RoIAlign 7), 5 epochs of 24 batches of 16 triplets with the paper's x0.7 decay every 2.
+    # Measured here: a SeanNet step takes 9.5 s, a ResNet-18 baseline step 2.0 s. Loader
+    # workers would only compete with torch for the two cores.
+    "cpu": TrainConfig().replace(
+        depth=18,
+        image_size=112,
+        roi_size=7,
+        visual_features="c5",
+        # with 1 the GCN pathways moved ~10x less than the backbone in the first batches
+        # (bench/branch_motion.py); 10 brings object fcn, GCN and fusion to its order
+        new_layers_lr_scale=10.0,
+        epochs=5,
+        batch_size=16,
+        decay_every=2,
+        max_train_batches=24,
+        max_val_triplets=160,
+        num_workers=0,
+    ),
+    # One GPU (run on an H100 with 16 cores, docs/results.md): ResNet-18 at the datasets'
+    # 224 px, x_v from the 5th-stage map, the cpu preset's schedule; loader workers decode the
+    # PNGs in parallel (the runs there were still loader-bound).
+    "gpu": TrainConfig().replace(
+        depth=18,
+        roi_size=14,
+        visual_features="c5",
+        new_layers_lr_scale=10.0,
+        epochs=5,
+        batch_size=16,
+        decay_every=2,
+        max_val_triplets=320,
+        num_workers=12,
+    ),
+}
+
+
+def preset(name: str) -> TrainConfig:
+    """A preset by name.
+
+    Raises:
+        ModelError: unknown preset.
+    """
+    try:
+        return PRESETS[name]
+    except KeyError:
+        raise ModelError(f"unknown preset {name!r}; expected one of {', '.join(PRESETS)}") from None

@@ -1,0 +1,146 @@
+"""The navigation test: motion, the navigator's labels, the rules on hand-made trajectories,
+and a short end-to-end run on the mini dataset that writes Table II."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import torch
+
+from seannet.data.live_views import LiveRooms
+from seannet.errors import ModelError, NavigationError
+from seannet.navigation.episodes import (
+    Step,
+    judge_episode,
+    judge_segment,
+    reached,
+    sample_episode,
+    step_verdict,
+)
+from seannet.navigation.maps import load_map
+from seannet.navigation.motion import apply, local_offset, turn_towards
+from seannet.navigation.navigate import run_navigation
+from seannet.navigation.navigator import (
+    NavigatorConfig,
+    VisualNavigator,
+    draw_pair,
+    label_for,
+    load_navigator,
+)
+from seannet.navigation.train_navigator import train_navigator
+from sgdata.seeds import episode_seed, rng_for
+
+EPS = 0.9
+GOAL = (4, 2, 0)
+
+
+def test_motion_moves_one_cell_and_turns_ninety_degrees() -> None:
+    assert apply((2, 2, 0), "forward") == (3, 2, 0)
+    assert apply((2, 2, 0), "left") == (2, 3, 0)  # left of +X is +Y (Z up)
+    assert apply((2, 2, 1), "right") == (3, 2, 1)
+    assert apply((2, 2, 3), "turn_left") == (2, 2, 0)
+    assert apply((2, 2, 0), "turn_right") == (2, 2, 3)
+    assert local_offset((2, 2, 1), (1, 5)) == (3, 1)  # 3 ahead (+Y), 1 to the left (-X)
+    assert turn_towards(0, 1) == "turn_left" and turn_towards(0, 3) == "turn_right"
+
+
+def test_navigator_labels_take_the_larger_displacement() -> None:
+    assert label_for(3, 1) == 0 and label_for(2, -2) == 0  # forward, forward on a tie
+    assert label_for(0, 2) == 1 and label_for(1, -2) == 2  # left, right
+    rng = np.random.default_rng(0)
+    reachable = np.ones((8, 8), dtype=bool)
+    for _ in range(50):
+        a, b, label = draw_pair(reachable, rng)
+        forward, side = local_offset(a, b[:2])
+        assert a[2] == b[2] and 0 <= forward <= 4 and abs(side) <= 2 and (forward, side) != (0, 0)
+        assert label == label_for(forward, side)
+    assert draw_pair(np.zeros((4, 4), dtype=bool), rng) is None
+    net = VisualNavigator(hidden=16)
+    assert net(torch.zeros(2, 3, 64, 64), torch.zeros(2, 3, 64, 64)).shape == (2, 3)
+    with pytest.raises(ModelError, match="image_size"):
+        NavigatorConfig(image_size=16)
+
+
+def test_reached_is_half_a_cell_and_ten_degrees() -> None:
+    assert reached(GOAL, GOAL)
+    assert not reached((5, 2, 0), GOAL) and not reached((4, 2, 1), GOAL)
+
+
+def test_every_outcome_from_hand_made_trajectories() -> None:
+    on_the_way = Step("forward", (3, 2, 0), similarity=0.5)
+    arrive = Step("forward", GOAL, similarity=0.95)
+    # success: two segments, each stopped on its goal
+    turn = Step("turn_left", (4, 2, 1), similarity=0.97)
+    assert judge_episode([(GOAL, [on_the_way, arrive]), ((4, 2, 1), [turn])], EPS) == (
+        "success",
+        -1,
+    )
+    # localization: stopped one cell short (a false positive) ...
+    assert judge_episode([(GOAL, [Step("forward", (3, 2, 0), similarity=0.93)])], EPS) == (
+        "localization",
+        0,
+    )
+    # ... or stood on the goal without stopping and walks past it
+    passed = [on_the_way, Step("forward", GOAL, similarity=0.6), Step("forward", (5, 2, 0))]
+    assert judge_segment(GOAL, passed, EPS) == ("localization", 2)
+    # navigation: k_max steps, never near the goal, never stopped
+    wander = [Step("left", (1, k, 0), similarity=0.1) for k in range(12)]
+    assert judge_episode([(GOAL, [arrive]), ((9, 9, 0), wander)], EPS) == ("navigation", 1)
+    assert judge_segment((9, 9, 0), wander + [Step("forward", (9, 9, 0), similarity=1.0)], EPS) == (
+        "navigation",
+        12,
+    )
+    # collision: a move into a blocked cell, whatever the localizer would say
+    assert step_verdict(Step("forward", GOAL, collided=True), GOAL, EPS) == "collision"
+    assert judge_episode([(GOAL, [on_the_way, Step("right", (3, 1, 0), collided=True)])], EPS) == (
+        "collision",
+        0,
+    )
+    with pytest.raises(NavigationError, match="decide nothing"):
+        judge_segment(GOAL, [on_the_way], EPS)
+
+
+def test_navigate_end_to_end_writes_table_two(
+    localizer_run: Path, mini_dataset: Path, tmp_path: Path
+) -> None:
+    config = NavigatorConfig(
+        image_size=64, hidden=16, epochs=1, batch_size=8, train_pairs=8, val_pairs=4
+    )
+    history = train_navigator(config, mini_dataset, tmp_path / "nav")
+    assert len(history) == 1 and (tmp_path / "nav" / "best.pt").is_file()
+    assert load_navigator(tmp_path / "nav").act(
+        np.zeros((96, 96, 3), np.uint8), np.zeros((96, 96, 3), np.uint8)
+    ) in ("forward", "left", "right")
+    run_navigation(
+        [localizer_run],
+        tmp_path / "nav",
+        mini_dataset,
+        episodes=2,
+        epsilon=0.95,
+        out=tmp_path / "out",
+        strips=tmp_path / "strips",
+    )
+    written = json.loads((tmp_path / "out" / "navigate_test.json").read_text())
+    (run,) = written["runs"]
+    for case in ("N", "A"):
+        row = run["table"][case]
+        assert row["total"] == 2  # one test room, two episodes per case
+        assert sum(row[k] for k in ("success", "navigation", "localization", "collision")) == (
+            pytest.approx(100.0)
+        )
+    assert "| localizer |" in (tmp_path / "out" / "navigate_test.md").read_text()
+    assert list((tmp_path / "strips" / localizer_run.name).glob("*.png"))
+    # reproducible: the episodes are drawn again from their seeds, with the same paths
+    (room_dir,) = (tmp_path / "out" / "maps" / localizer_run.name).iterdir()
+    topo = load_map(room_dir)
+    with LiveRooms(mini_dataset) as live:
+        for record in run["episodes"]:
+            rng = rng_for(episode_seed(0, record["room_id"], record["case"], record["index"]))
+            episode = sample_episode(topo, live, record["case"], rng, index=record["index"])
+            assert [list(p) for p in episode.path] == record["path"]
+            assert episode.layout == record["layout"] != topo.layout
+            if record["case"] == "N":
+                assert len(episode.path) == 2
