@@ -23,7 +23,7 @@ import numpy as np
 import torch
 from torch import Tensor
 
-from seannet.data.batch import NUM_RELATIONS, SceneBatch, normalise_pixels
+from seannet.data.batch import NUM_RELATIONS, SceneBatch
 from seannet.data.view_inputs import dense_adjacency
 from seannet.errors import DataError
 
@@ -59,8 +59,7 @@ class ViewTensors:
         std: per-channel std, as ``mean``.
 
     The adjacency travels sparse (a dense one is 3 x M x M floats, 786 KB at M = 256) and is
-    made dense on the model's device; :attr:`adjacency` gives it per view, and
-    :attr:`normalised_image` the float image the model sees.
+    made dense on the model's device; :attr:`adjacency` gives it per view.
     """
 
     image: Tensor
@@ -77,11 +76,6 @@ class ViewTensors:
     def adjacency(self) -> Tensor:
         """(3, M, M) float32, row-normalised on / in / proximity (absent nodes: zero rows)."""
         return dense_adjacency(self.edge_index, self.edge_weight, self.num_slots)
-
-    @property
-    def normalised_image(self) -> Tensor:
-        """(3, S, S) float32, ``(x / 255 - mean) / std``: what the model's input holds."""
-        return normalise_pixels(self.image, self.mean, self.std)
 
 
 @dataclass

@@ -119,7 +119,6 @@ class LiveRooms:
         self.layout = -1
         self.grid: Any = None  # sgdata.world.poses.PoseGrid of the loaded layout
         self._room: Any = None
-        self._boxes: dict[int, tuple[np.ndarray, np.ndarray]] = {}
 
     # -- lifecycle ------------------------------------------------------------------------
 
@@ -153,16 +152,11 @@ class LiveRooms:
         self.annotator.set_layout(room, geometry, layout)
         self.room_id, self.layout, self._room = room_id, int(layout), room
         self.grid = self.poses.grid(room)
-        self._boxes = _boxes(room, geometry)
 
     def reachable(self, i: int, j: int) -> bool:
         """Whether cell (i, j) is on the loaded layout's reachable grid."""
         nx, ny = self.grid.shape
         return 0 <= i < nx and 0 <= j < ny and bool(self.grid.reachable[i, j])
-
-    def object_boxes(self) -> dict[int, tuple[np.ndarray, np.ndarray]]:
-        """Instance -> (world box min, max) of every object of the loaded layout."""
-        return dict(self._boxes)
 
     # -- views ----------------------------------------------------------------------------
 

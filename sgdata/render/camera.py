@@ -51,11 +51,6 @@ class CameraConfig:
         """Vertical field of view in radians."""
         return 2.0 * math.atan((self.height / 2.0) / self.focal)
 
-    def intrinsics(self) -> np.ndarray:
-        """3x3 K mapping camera (right, down, forward) coordinates to continuous pixels."""
-        f = self.focal
-        return np.array([[f, 0.0, self.width / 2.0], [0.0, f, self.height / 2.0], [0, 0, 1.0]])
-
     def basis(self, theta: float) -> np.ndarray:
         """Rows right, up, forward (world unit vectors) for heading ``theta`` (rad about +Z)."""
         p = math.radians(self.pitch_deg)
