@@ -100,14 +100,31 @@ def evaluate(
     run: Annotated[Path, typer.Argument(help="Run directory (holds best.pt).")],
     data: Data,
     split: Annotated[str, typer.Option(help="Split to evaluate.")] = "test",
+    boxes: Annotated[
+        bool,
+        typer.Option(
+            "--boxes/--no-boxes", help="Score S + lambda * box overlap, lambda chosen on val."
+        ),
+    ] = False,
+    box_noise: Annotated[
+        float, typer.Option(help="S: box corners jittered by S x box size (normal std).")
+    ] = 0.0,
+    drop: Annotated[float, typer.Option(help="P: each object missed with probability P.")] = 0.0,
+    spurious: Annotated[
+        float, typer.Option(help="Q: false objects of a random class, Q per true object.")
+    ] = 0.0,
+    noise_seed: Annotated[int, typer.Option(help="Seed of the box noise.")] = 0,
 ) -> None:
-    """Triplet accuracy (overall, per room, per tier), similarity heat maps, threshold."""
-    from seannet.evaluation.eval import evaluate_run
+    """Triplet accuracy (overall, per room, per tier), similarity heat maps, threshold;
+    optionally with the box overlap (--boxes) or under labeler / detector box noise."""
+    from seannet.data.box_noise import BoxNoise
+    from seannet.evaluation.eval import eval_file, evaluate_run
 
-    result = evaluate_run(run, data, split=split)
-    console.print((run / f"eval_{split}.md").read_text())
-    console.print(f"wrote {run}/eval_{split}.json, heat_mean_{split}.png, heat_std_{split}.png")
-    del result
+    noise = BoxNoise(jitter=box_noise, drop=drop, spurious=spurious, seed=noise_seed)
+    evaluate_run(run, data, split=split, boxes=boxes, noise=noise)
+    written = eval_file(run, split, boxes=boxes, noise=noise)
+    console.print(written.with_suffix(".md").read_text())
+    console.print(f"wrote {written}")
 
 
 @app.command()
@@ -117,12 +134,11 @@ def compare(
     models: Annotated[
         str,
         typer.Option(
-            help="Comma-separated specs NAME[@lite0][+imagenet]: seannet, seannet-graph, "
-            "resnet18, seannet@lite0+imagenet, efficientnet_lite0+imagenet, ..."
+            help="Comma-separated specs NAME[@lite0][+imagenet][+boxes]: seannet, "
+            "seannet-graph, resnet18, resnet18+boxes, seannet@lite0+imagenet, ..."
         ),
     ] = "seannet,resnet18",
     preset: Annotated[str, typer.Option(help="cpu | gpu | paper")] = "cpu",
-    split: Annotated[str, typer.Option(help="Split to compare on.")] = "test",
     seeds: Annotated[str, typer.Option(help="Comma-separated training seeds.")] = "0",
     lrs: Annotated[
         str,
@@ -134,8 +150,11 @@ def compare(
     batches: Annotated[
         int | None, typer.Option(help="Batches per epoch for every model (instead of --budget).")
     ] = None,
+    tag: Annotated[
+        str, typer.Option(help="Name of this comparison's files (several may share --out).")
+    ] = "",
 ) -> None:
-    """Train every model under one budget, pick its lr on val, repeat over seeds, one table."""
+    """Every model under one budget, every choice on val (selection.json first), test once."""
     from seannet.evaluation.compare import COMPARISON, compare_models
     from seannet.training.config import preset as load_preset
 
@@ -153,14 +172,15 @@ def compare(
         out,
         names,
         preset=base if batches is not None else preset,
-        split=split,
         seeds=seed_list,
         lrs=lr_list,
         budget_s=budget,
         announce=console.print,
+        tag=tag,
     )
-    console.print((out / f"{COMPARISON}.md").read_text())
-    console.print(f"wrote {out / COMPARISON}.json and .md")
+    written = out / (f"{COMPARISON}-{tag}" if tag else COMPARISON)
+    console.print(written.with_suffix(".md").read_text())
+    console.print(f"wrote {written}.json and .md")
 
 
 @app.command()

@@ -40,6 +40,7 @@ __all__ = [
     "navigator_pairs_seed",
     "navigator_order_seed",
     "episode_seed",
+    "box_noise_seed",
     "room_look_seed",
     "appearance_seed",
     "texture_seed",
@@ -49,6 +50,7 @@ _TRIPLETS = "triplets"  # the purpose key of triplet streams
 _INIT = 1 << 20  # the initial weights (epochs use 0, 1, 2, ...)
 _NAVIGATOR = "navigator"  # the purpose key of the visual navigator's streams
 _EPISODES = "episodes"  # the purpose key of the navigation test's episodes
+_BOX_NOISE = "box noise"  # the purpose key of evaluation's labeler / detector noise
 _LOOKS = "looks"  # the purpose key of a room's base looks (texture variants)
 _APPEARANCE = "appearance"  # the purpose key of a layout's appearance draw
 _TEXTURES = "textures"  # the root key of procedural texture images
@@ -146,6 +148,12 @@ def episode_seed(test_seed: int, room_id: str, case: str, index: int) -> int:
     """One navigation-test episode (its layout, start and goal), by names: every localizer
     run is tested on the same episodes."""
     return derive_seed(test_seed, name_key(_EPISODES), name_key(room_id), name_key(case), index)
+
+
+def box_noise_seed(noise_seed: int, obs_id: str) -> int:
+    """The noise one view's boxes get in an evaluation under box noise (by name: the same
+    whatever order or batch the view is read in)."""
+    return derive_seed(noise_seed, name_key(_BOX_NOISE), name_key(obs_id))
 
 
 def room_look_seed(room: int) -> int:

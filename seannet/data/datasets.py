@@ -39,6 +39,7 @@ import pyarrow.parquet as pq
 from torch import Tensor
 from torch.utils.data import Dataset as TorchDataset
 
+from seannet.data.box_noise import BoxNoise
 from seannet.data.collate import (
     ObservationItem,
     ObservationItems,
@@ -157,20 +158,19 @@ class _Shard:
     def __len__(self) -> int:
         return len(self.obj_offsets) - 1
 
-    def graph(self, row: int, num_slots: int) -> tuple[Tensor, ...]:
-        """Row ``row``'s :func:`graph_from_columns` tensors."""
+    def graph(self, row: int, num_slots: int, noise: _Noise | None = None) -> tuple[Tensor, ...]:
+        """Row ``row``'s :func:`graph_from_columns` tensors (its boxes under ``noise``:
+        ``(BoxNoise, obs_id, slot_runs, image_hw)``, when given)."""
         o0, o1 = self.obj_offsets[row], self.obj_offsets[row + 1]
         r0, r1 = self.rel_offsets[row], self.rel_offsets[row + 1]
-        return graph_from_columns(
-            self.instance[o0:o1],
-            self.class_id[o0:o1],
-            self.slot[o0:o1],
-            self.box2d[o0:o1],
-            self.src[r0:r1],
-            self.dst[r0:r1],
-            self.type[r0:r1],
-            num_slots,
-        )
+        objects = (self.instance[o0:o1], self.class_id[o0:o1], self.slot[o0:o1], self.box2d[o0:o1])
+        relations = (self.src[r0:r1], self.dst[r0:r1], self.type[r0:r1])
+        if noise is not None:
+            box_noise, obs_id, slot_runs, image_hw = noise
+            objects, relations = box_noise.apply(
+                obs_id, objects, relations, slot_runs=slot_runs, image_hw=image_hw
+            )
+        return graph_from_columns(*objects, *relations, num_slots)
 
 
 class _PixelBuffers:
@@ -219,10 +219,15 @@ class _ViewStore:
         split: str,
         transform: ImageTransform,
         images: CachedImages | None = None,
+        noise: BoxNoise | None = None,
     ) -> None:
         self.split = split
         self.transform = transform
         self.num_slots = int(ds.manifest.num_slots)
+        self.noise = noise if noise is not None and noise.active else None
+        classes = ds.manifest.classes
+        self.slot_runs = np.array([(c.slot_start, c.slot_count) for c in classes], np.int64)
+        self.image_hw = (int(ds.manifest.image.height), int(ds.manifest.image.width))
         self.files = [str(p) for p in _call(ds.observation_files, split)]
         table = _call(ds.observations, split, columns=list(_META_COLUMNS))
         self.meta: dict[str, list[Any]] = {n: table.column(n).to_pylist() for n in _META_COLUMNS}
@@ -293,10 +298,13 @@ class _ViewStore:
             if len(shard) != self.file_starts[f + 1] - self.file_starts[f]:
                 raise DataError(f"{self.files[f]}: changed while being read; open it again")
             for row in range(len(shard)):
+                obs = self.obs_ids[int(self.file_starts[f]) + row]
+                noise = None
+                if self.noise is not None:
+                    noise = (self.noise, obs, self.slot_runs, self.image_hw)
                 try:
-                    parts.append(shard.graph(row, self.num_slots))
+                    parts.append(shard.graph(row, self.num_slots, noise))
                 except DataError as exc:
-                    obs = self.obs_ids[int(self.file_starts[f]) + row]
                     raise DataError(f"observation {obs!r}: {exc}") from None
         slots, class_ids, boxes, edges, weights = ([p[k].numpy() for p in parts] for k in range(5))
         box_offsets = offsets_of([len(x) for x in slots])
@@ -365,6 +373,8 @@ class _ViewStore:
 
 
 _NO_BOXES = np.zeros((0, 4), dtype=np.float32)
+# a view's box noise: (noise, obs_id, slot runs (C, 2), stored image (height, width))
+_Noise = tuple[BoxNoise, str, np.ndarray, tuple[int, int]]
 
 
 def _call(fn: Any, *args: Any, **kwargs: Any) -> Any:
@@ -389,6 +399,7 @@ def _open_split(
     split: str,
     transform: ImageTransform | None,
     cache: bool | str | Path,
+    noise: BoxNoise | None = None,
 ) -> Dataset:
     """The attributes both datasets share: root, split, transform, identity and view store."""
     ds = open_dataset(root)
@@ -400,7 +411,7 @@ def _open_split(
     if cache is not False and cache is not None:
         cache_dir = None if cache is True else Path(cache)
         images = open_image_cache(ds, split, target.transform, cache_dir=cache_dir)
-    target._store = _ViewStore(ds, split, target.transform, images)
+    target._store = _ViewStore(ds, split, target.transform, images, noise)
     return ds
 
 
@@ -495,6 +506,8 @@ class ObservationDataset(TorchDataset):
         split: ``train``, ``val`` or ``test``.
         transform: image size and normalisation (default 224 px, ImageNet statistics).
         cache: as for :class:`TripletDataset` (default ``False``: decode per view).
+        noise: the boxes as a labeler or detector would give them (:class:`BoxNoise`;
+            default: the dataset's own boxes).
 
     Raises:
         DataError: the dataset or split is missing or malformed, or the image cache cannot
@@ -508,8 +521,9 @@ class ObservationDataset(TorchDataset):
         *,
         transform: ImageTransform | None = None,
         cache: bool | str | Path = False,
+        noise: BoxNoise | None = None,
     ) -> None:
-        _open_split(self, root, split, transform, cache)
+        _open_split(self, root, split, transform, cache, noise)
 
     def __len__(self) -> int:
         return len(self._store.obs_ids)
@@ -518,6 +532,13 @@ class ObservationDataset(TorchDataset):
     def obs_ids(self) -> list[str]:
         """Observation ids in item order."""
         return list(self._store.obs_ids)
+
+    def slot_boxes(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Every view's objects as the model sees them (noise included), in item order:
+        ``(offsets (N + 1,), slots (K,), boxes (K, 4))``; view v's are ``offsets[v]:[v + 1]``
+        (boxes in the stored image's pixels, or the cache's frame with the cache)."""
+        g = self._store.graphs()
+        return g.box_offsets, g.slots, g.boxes
 
     def __getitem__(self, i: int) -> ObservationItem:
         if not -len(self) <= i < len(self):

@@ -1,17 +1,28 @@
-"""``seannet compare``: train every model under one wall-clock budget, pick each model's
-learning rate on the validation rooms, repeat over seeds, and report mean +- std and a 95 %
-interval per model.
+"""``seannet compare``: every model under one budget rule, every choice on the validation
+rooms, the test rooms read once, and intervals over rooms and seeds.
 
-Fairness, as measured rather than assumed: every model gets the same *seconds* of training
-(not the same number of batches), calibrated once per model by timing a few training steps;
-the batch count that budget buys is recorded, so a rerun with the recorded figures trains
-exactly the same. The learning rate of each model is the best of ``lrs`` on the validation
-split (seed 0), and the seeds reuse it.
+The protocol (DESIGN §12), in the order it runs:
 
-A model is named by a spec ``NAME[@lite0][+imagenet]``: ``NAME`` a model or ablation
+1. **Budget.** Every model gets the same *seconds* of training (not the same number of
+   batches), calibrated once per trained network by timing a few steps; the batch count it
+   buys is recorded, so a rerun with the recorded figures trains exactly the same.
+2. **Selection, on val only.** For each learning rate of ``lrs``, seed 0 is trained and its
+   best epoch (per-epoch val) is evaluated on the *whole* val split; the lr with the best val
+   accuracy is chosen (ties: the smaller), and the other seeds are trained at it. A
+   ``+boxes`` spec chooses its lambda on val in the same evaluation.
+3. ``selection.json`` is written: each model's chosen lr, its val accuracy by lr, its runs.
+   No test row has been read until then (``on_selected`` is called at that point).
+4. **Test, once.** Each chosen run is evaluated on the test split.
+5. **Intervals.** Per model, a two-level bootstrap over rooms and seeds and the seed-level
+   t-interval; for the first model minus each other, the paired two-level bootstrap and
+   Welch's seed-level interval (:mod:`seannet.evaluation.intervals`).
+
+A model is named by a spec ``NAME[@lite0][+imagenet][+boxes]``: ``NAME`` a model or ablation
 (``seannet``, ``seannet-graph``, ``resnet18``, ``efficientnet_lite0``, ...), ``@lite0`` puts
 SeanNet on the EfficientNet-Lite0 image network, ``+imagenet`` starts that network from the
-ImageNet weights that install offline (the `lite` extra), e.g. ``seannet@lite0+imagenet``.
+ImageNet weights that install offline (the `lite` extra), ``+boxes`` adds the hand-made box
+overlap to the similarity (:mod:`seannet.evaluation.box_overlap`; its runs are ``NAME``'s:
+``resnet18`` and ``resnet18+boxes`` train once).
 """
 
 from __future__ import annotations
@@ -21,50 +32,74 @@ import json
 import math
 import time
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pyarrow.parquet as pq
 import torch
-from scipy import stats
 from torch.utils.data import DataLoader
 
 from seannet.data.datasets import ImageTransform, TripletDataset, collate_triplets
 from seannet.errors import ModelError
 from seannet.evaluation.eval import evaluate_run
+from seannet.evaluation.intervals import (
+    per_room_matrix,
+    t_interval,
+    two_level_difference,
+    two_level_interval,
+    welch_difference,
+)
 from seannet.model.loss import TripletLoss
 from seannet.training.config import TrainConfig
 from seannet.training.config import preset as load_preset
 from seannet.training.loop import train_one_epoch, triplet_step
-from seannet.training.runs import HISTORY, LAST, build_for_dataset, device_for_run
+from seannet.training.runs import LAST, build_for_dataset, device_for_run
 from seannet.training.train import param_groups, train
 from seannet.weights import LITE0, LITE0_WEIGHTS
+from sgdata.dataset import Dataset
 from sgdata.fileio import atomic_write_text
 
 __all__ = [
     "COMPARISON",
+    "SELECTION",
+    "ModelSpec",
     "calibrate_batches",
     "compare_models",
     "model_spec",
-    "paired_difference",
     "summarize",
     "triplets_per_room",
 ]
 
 COMPARISON = "comparison"  # comparison.json and comparison.md under the output directory
+SELECTION = "selection.json"  # every choice, written before any test row is read
 _CALIBRATION_STEPS = 3  # timed training steps (after one warm-up) per model
+_BOXES = "+boxes"
+_IMAGENET = "+imagenet"
 
 
-def model_spec(spec: str, base: TrainConfig) -> tuple[TrainConfig, Path | None]:
-    """The training config and ImageNet weights a spec ``NAME[@lite0][+imagenet]`` names.
+@dataclass(frozen=True)
+class ModelSpec:
+    """What a spec names: the network trained, its weights, how its pairs are scored."""
+
+    spec: str  # as given, e.g. "resnet18+boxes"
+    trained: str  # the trained network's spec (its run directory), e.g. "resnet18"
+    config: TrainConfig
+    pretrained: Path | None
+    boxes: bool
+
+
+def model_spec(spec: str, base: TrainConfig) -> ModelSpec:
+    """What a spec ``NAME[@lite0][+imagenet][+boxes]`` names.
 
     Raises:
         ModelError: ``@`` names another image network, or ``+imagenet`` asks for weights the
             spec's image network has none of offline (only EfficientNet-Lite0 has).
     """
-    imagenet = spec.endswith("+imagenet")
-    name, _, network = spec.removesuffix("+imagenet").partition("@")
+    boxes = spec.endswith(_BOXES)
+    trained = spec.removesuffix(_BOXES)
+    imagenet = trained.endswith(_IMAGENET)
+    name, _, network = trained.removesuffix(_IMAGENET).partition("@")
     config = base.replace(model=name)
     if network:
         if network != "lite0" or not name.startswith("seannet"):
@@ -75,7 +110,8 @@ def model_spec(spec: str, base: TrainConfig) -> tuple[TrainConfig, Path | None]:
             f"model {spec!r}: +imagenet needs the EfficientNet-Lite0 network "
             f"(seannet@lite0 or {LITE0}); no other ImageNet weights install offline"
         )
-    return config, Path(LITE0_WEIGHTS) if imagenet else None
+    pretrained = Path(LITE0_WEIGHTS) if imagenet else None
+    return ModelSpec(spec, trained, config, pretrained, boxes)
 
 
 def compare_models(
@@ -84,73 +120,110 @@ def compare_models(
     models: Sequence[str],
     *,
     preset: str | TrainConfig = "cpu",
-    split: str = "test",
     seeds: Sequence[int] = (0,),
     lrs: Sequence[float] = (),
     budget_s: float | None = None,
     announce: Callable[[str], None] | None = None,
+    on_selected: Callable[[Path], None] | None = None,
+    tag: str = "",
 ) -> dict[str, Any]:
-    """Train and evaluate every model; write ``out/comparison.{json,md}`` and return it.
+    """Select on val, test once; write ``out/selection.json`` then ``out/comparison.{json,md}``.
 
-    Runs live in ``out/<model>/lr<lr>/seed<k>``; a run that has a checkpoint resumes, so an
-    interrupted comparison picks up where it stopped.
+    Runs live in ``out/<trained spec>/lr<lr>/seed<k>``; a run that has a checkpoint resumes,
+    so an interrupted comparison picks up where it stopped.
 
     Args:
-        preset: a preset name or a :class:`TrainConfig` (its ``model`` is replaced).
-        seeds: training seeds; each model's figures are their mean, std and 95 % interval.
-        lrs: candidate learning rates, chosen per model on ``val`` (default: the preset's).
+        preset: a preset name or a :class:`TrainConfig` (its model is replaced).
+        seeds: training seeds (the first one selects the lr).
+        lrs: candidate learning rates, chosen per model on val (default: the preset's).
         budget_s: training seconds per run; None keeps the preset's batch count for all.
+        on_selected: called with the selection file once it is written, before any test row
+            is read.
+        tag: names this comparison's files (``selection-<tag>.json``, ...), so comparisons of
+            different model sets can share one ``out`` and its runs.
 
     Raises:
-        ModelError: no model or no seed named.
+        ModelError: no model or no seed named, or a bad spec.
     """
     if not models or not seeds:
         raise ModelError("name at least one model (--models) and one seed (--seeds)")
     say = announce or (lambda _text: None)
     base = load_preset(preset) if isinstance(preset, str) else preset
-    name_of_preset = preset if isinstance(preset, str) else "custom"
-    results: dict[str, Any] = {"preset": name_of_preset, "split": split, "budget_s": budget_s}
-    entries = []
-    specs = {name: model_spec(name, base) for name in models}  # refuse a bad spec before work
-    for name, (config, pretrained) in specs.items():
+    specs = [model_spec(name, base) for name in models]  # refuse a bad spec before work
+    batches: dict[str, int] = {}
+    chosen = []
+    for spec in specs:
+        config = spec.config
         if budget_s is not None:
-            batches = calibrate_batches(config, data, budget_s)
-            config = config.replace(max_train_batches=batches)
-            say(f"{name}: {batches} batches per epoch fill {budget_s:.0f} s")
-        sweep = {}
-        for lr in lrs or (config.lr,):
-            run = _run_dir(out, name, lr, seeds[0])
-            say(f"{name}: lr {lr:g}, seed {seeds[0]} -> {run}")
-            _train(config.replace(lr=lr, seed=seeds[0]), data, run, pretrained)
-            sweep[lr] = max(h["val_accuracy"] for h in json.loads((run / HISTORY).read_text()))
-        lr = max(sweep, key=lambda k: (sweep[k], -k))  # best val accuracy; ties: the smaller
-        runs = []
-        for seed in seeds:
-            run = _run_dir(out, name, lr, seed)
-            if seed != seeds[0]:
-                say(f"{name}: lr {lr:g}, seed {seed} -> {run}")
-                _train(config.replace(lr=lr, seed=seed), data, run, pretrained)
-            runs.append(evaluate_run(run, data, split=split))
-        entries.append(
-            {
-                "model": name,
-                "pretrained": str(pretrained) if pretrained else None,
-                "lr": lr,
-                "val_accuracy_by_lr": {f"{k:g}": v for k, v in sweep.items()},
-                "batches_per_epoch": config.max_train_batches,
-                "epochs": config.epochs,
-                "summary": summarize(runs),
-                "runs": runs,
-            }
-        )
-    results["models"] = entries
-    counts = triplets_per_room(data, split)
-    for entry in entries[1:]:
-        entry["difference_to_first"] = paired_difference(entries[0]["runs"], entry["runs"], counts)
+            if spec.trained not in batches:
+                batches[spec.trained] = calibrate_batches(config, data, budget_s)
+                filled = f"{batches[spec.trained]} batches per epoch fill {budget_s:.0f} s"
+                say(f"{spec.trained}: {filled}")
+            config = config.replace(max_train_batches=batches[spec.trained])
+        chosen.append(_select(spec, config, data, out, seeds, lrs or (config.lr,), say))
+    selection = {
+        "preset": preset if isinstance(preset, str) else "custom",
+        "budget_s": budget_s,
+        "seeds": list(seeds),
+        "lrs": [float(lr) for lr in (lrs or (base.lr,))],
+        "models": chosen,
+    }
     out.mkdir(parents=True, exist_ok=True)
-    atomic_write_text(out / f"{COMPARISON}.json", json.dumps(results, indent=2))
-    atomic_write_text(out / f"{COMPARISON}.md", markdown(results))
+    suffix = f"-{tag}" if tag else ""
+    selection_file = out / SELECTION.replace(".json", f"{suffix}.json")
+    atomic_write_text(selection_file, json.dumps(selection, indent=2))
+    if on_selected is not None:
+        on_selected(selection_file)
+    entries = []
+    for spec, choice in zip(specs, chosen, strict=True):
+        say(f"{spec.spec}: test, lr {choice['lr']:g}")
+        runs = [evaluate_run(Path(r), data, split="test", boxes=spec.boxes) for r in choice["runs"]]
+        entries.append({**choice, "summary": summarize(runs), "runs": runs})
+    counts = triplets_per_room(data, "test")
+    for entry in entries:
+        entry["summary"]["two_level"] = _two_level(entry["runs"], counts)
+    for entry in entries[1:]:
+        entry["difference_to_first"] = _difference(entries[0]["runs"], entry["runs"], counts)
+    results = {**selection, "split": "test", "models": entries}
+    atomic_write_text(out / f"{COMPARISON}{suffix}.json", json.dumps(results, indent=2))
+    atomic_write_text(out / f"{COMPARISON}{suffix}.md", markdown(results))
     return results
+
+
+def _select(
+    spec: ModelSpec,
+    config: TrainConfig,
+    data: Path,
+    out: Path,
+    seeds: Sequence[int],
+    lrs: Sequence[float],
+    say: Callable[[str], None],
+) -> dict[str, Any]:
+    """Train seed 0 at every lr, choose the lr on the whole val split, train the seeds."""
+    sweep = {}
+    for lr in lrs:
+        run = _run_dir(out, spec.trained, lr, seeds[0])
+        say(f"{spec.spec}: lr {lr:g}, seed {seeds[0]} -> {run}")
+        _train(config.replace(lr=lr, seed=seeds[0]), data, run, spec.pretrained)
+        sweep[lr] = evaluate_run(run, data, split="val", boxes=spec.boxes)["accuracy"]
+    lr = max(sweep, key=lambda k: (sweep[k], -k))  # best val accuracy; ties: the smaller
+    runs = []
+    for seed in seeds:
+        run = _run_dir(out, spec.trained, lr, seed)
+        if seed != seeds[0]:
+            say(f"{spec.spec}: lr {lr:g}, seed {seed} -> {run}")
+            _train(config.replace(lr=lr, seed=seed), data, run, spec.pretrained)
+        runs.append(str(run))
+    return {
+        "model": spec.spec,
+        "trained": spec.trained,
+        "pretrained": str(spec.pretrained) if spec.pretrained else None,
+        "lr": lr,
+        "val_accuracy_by_lr": {f"{k:g}": v for k, v in sweep.items()},
+        "batches_per_epoch": config.max_train_batches,
+        "epochs": config.epochs,
+        "runs": runs,
+    }
 
 
 def _run_dir(out: Path, name: str, lr: float, seed: int) -> Path:
@@ -191,28 +264,19 @@ def calibrate_batches(config: TrainConfig, data: Path, budget_s: float) -> int:
     return max(1, int(per_epoch / float(np.median(seconds))))
 
 
-def _interval(values: list[float]) -> dict[str, float]:
-    """Mean, std (ddof 1) and the half-width of a 95 % t interval of the mean."""
-    x = np.asarray(values, dtype=np.float64)
-    n = len(x)
-    std = float(x.std(ddof=1)) if n > 1 else float("nan")
-    half = float(stats.t.ppf(0.975, n - 1) * std / math.sqrt(n)) if n > 1 else float("nan")
-    return {"mean": float(x.mean()), "std": std, "ci95": half, "n": n}
-
-
 def summarize(runs: list[dict[str, Any]]) -> dict[str, Any]:
-    """Per-metric mean / std / 95 % interval over the seeds' evaluation results."""
+    """Per-metric mean / std / 95 % t-interval over the seeds' evaluation results."""
     first = runs[0]
     summary = {
-        "accuracy": _interval([r["accuracy"] for r in runs]),
-        "recall1": _interval([r["retrieval"]["recall"][1] for r in runs]),
-        "recall5": _interval([r["retrieval"]["recall"][5] for r in runs]),
-        "d_prime": _interval([r["separation"]["d_prime"] for r in runs]),
+        "accuracy": t_interval([r["accuracy"] for r in runs]),
+        "recall1": t_interval([r["retrieval"]["recall"][1] for r in runs]),
+        "recall5": t_interval([r["retrieval"]["recall"][5] for r in runs]),
+        "d_prime": t_interval([r["separation"]["d_prime"] for r in runs]),
         "per_tier": {
-            str(k): _interval([r["per_tier"][k] for r in runs]) for k in first["per_tier"]
+            str(k): t_interval([r["per_tier"][k] for r in runs]) for k in first["per_tier"]
         },
         "by_moved": {
-            k: _interval([r["by_moved"][k]["accuracy"] for r in runs]) for k in first["by_moved"]
+            k: t_interval([r["by_moved"][k]["accuracy"] for r in runs]) for k in first["by_moved"]
         },
         "triplets": first["triplets"],
         "rooms": len(first["per_room"]),
@@ -224,34 +288,30 @@ def summarize(runs: list[dict[str, Any]]) -> dict[str, Any]:
     return summary
 
 
-def paired_difference(
-    runs_a: list[dict[str, Any]],
-    runs_b: list[dict[str, Any]],
-    triplets_per_room: dict[str, int],
-    *,
-    resamples: int = 10_000,
-) -> dict[str, float]:
-    """Triplet accuracy of A minus B on the same rooms, with a 95 % room-bootstrap interval.
+def _two_level(runs: list[dict[str, Any]], counts: dict[str, int]) -> dict[str, float]:
+    rooms = sorted(counts)
+    weight = np.array([counts[r] for r in rooms], dtype=np.float64)
+    return two_level_interval(per_room_matrix(runs, rooms), weight)
 
-    Each room's accuracy is averaged over each model's seeds, the difference weighted by the
-    room's triplets; the rooms are resampled (a fixed seed: the same figures every time).
-    Why rooms: triplets of one room share its views and layouts, so they are not independent;
-    the rooms are, and pairing removes what the two models find equally hard.
-    """
-    rooms = sorted(triplets_per_room)
-    a = np.mean([[r["per_room"][room] for room in rooms] for r in runs_a], axis=0)
-    b = np.mean([[r["per_room"][room] for room in rooms] for r in runs_b], axis=0)
-    weight = np.array([triplets_per_room[room] for room in rooms], dtype=np.float64)
-    pick = np.random.default_rng(0).integers(0, len(rooms), size=(resamples, len(rooms)))
-    boot = ((a - b)[pick] * weight[pick]).sum(1) / weight[pick].sum(1)
-    low, high = np.percentile(boot, [2.5, 97.5])
-    diff = float(((a - b) * weight).sum() / weight.sum())
-    return {"mean": diff, "low": float(low), "high": float(high), "rooms": len(rooms)}
+
+def _difference(
+    runs_a: list[dict[str, Any]], runs_b: list[dict[str, Any]], counts: dict[str, int]
+) -> dict[str, Any]:
+    """A minus B: paired two-level bootstrap over rooms and seeds, and Welch over seeds."""
+    rooms = sorted(counts)
+    weight = np.array([counts[r] for r in rooms], dtype=np.float64)
+    a, b = per_room_matrix(runs_a, rooms), per_room_matrix(runs_b, rooms)
+    return {
+        **two_level_difference(a, b, weight),
+        "seeds_t": welch_difference(
+            [r["accuracy"] for r in runs_a], [r["accuracy"] for r in runs_b]
+        ),
+    }
 
 
 def triplets_per_room(data: Path, split: str) -> dict[str, int]:
     """How many ``split`` triplets each room holds (from the dataset's triplet table)."""
-    rooms = pq.read_table(data / "triplets" / f"{split}.parquet", columns=["room_id"])
+    rooms = Dataset.open(data).triplets(split)
     names, counts = np.unique(rooms.column("room_id").to_numpy(), return_counts=True)
     return {str(n): int(c) for n, c in zip(names, counts, strict=True)}
 
@@ -261,35 +321,47 @@ def _pm(entry: dict[str, float]) -> str:
     return f"{mean:.1f} ± {ci:.1f}" if not math.isnan(ci) else f"{mean:.1f}"
 
 
+def _range(entry: dict[str, float]) -> str:
+    return f"{100 * entry['mean']:+.1f} [{100 * entry['low']:+.1f}, {100 * entry['high']:+.1f}]"
+
+
 def markdown(results: dict[str, Any]) -> str:
-    """The comparison as markdown tables (mean ± 95 % interval over seeds, in %)."""
+    """The comparison as markdown tables (in %): mean ± 95 % t-interval over seeds, and the
+    two-level (rooms x seeds) interval."""
     rows = [
-        f"# Comparison on {results['split']} (preset {results['preset']}, "
-        f"budget {results['budget_s']} s per run)",
+        f"# Comparison on test (preset {results['preset']}, budget {results['budget_s']} s "
+        f"per run; lr of each model chosen on val from {results['lrs']})",
         "",
-        "| model | lr | seeds | triplet acc | recall@1 | recall@5 | tier 0 | tier 1 | d' | "
-        "triplets / rooms |",
-        "|---|---|---|---|---|---|---|---|---|---|",
+        "| model | lr | val acc | seeds | test acc (seeds t) | rooms x seeds 95 % | recall@1 | "
+        "tier 0 | tier 1 | d' | triplets / rooms |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for e in results["models"]:
         s = e["summary"]
         tiers = s["per_tier"]
+        two = s["two_level"]
+        val = e["val_accuracy_by_lr"][f"{e['lr']:g}"]
         rows.append(
-            f"| {e['model']} | {e['lr']:g} | {s['accuracy']['n']} | {_pm(s['accuracy'])} | "
-            f"{_pm(s['recall1'])} | {_pm(s['recall5'])} | "
+            f"| {e['model']} | {e['lr']:g} | {100 * val:.1f} | "
+            f"{s['accuracy']['n']} | {_pm(s['accuracy'])} | "
+            f"[{100 * two['low']:.1f}, {100 * two['high']:.1f}] | {_pm(s['recall1'])} | "
             f"{_pm(tiers['0']) if '0' in tiers else '-'} | "
             f"{_pm(tiers['1']) if '1' in tiers else '-'} | "
             f"{s['d_prime']['mean']:.2f} | {s['triplets']} / {s['rooms']} |"
         )
     if len(results["models"]) > 1:
         first = results["models"][0]["model"]
-        rows += ["", f"{first} minus each model, same rooms (95 % room-bootstrap interval):", ""]
+        rows += [
+            "",
+            f"{first} minus each model on the same rooms, points: paired two-level bootstrap "
+            "(rooms x seeds) and Welch's seed-level t-interval, 95 %:",
+            "",
+            "| model | rooms x seeds | seeds (t) |",
+            "|---|---|---|",
+        ]
         for e in results["models"][1:]:
             d = e["difference_to_first"]
-            rows.append(
-                f"- {e['model']}: {100 * d['mean']:+.1f} points "
-                f"[{100 * d['low']:+.1f}, {100 * d['high']:+.1f}] over {d['rooms']} rooms"
-            )
+            rows.append(f"| {e['model']} | {_range(d)} | {_range(d['seeds_t'])} |")
     rows += ["", "Accuracy by moved objects in view (mean over seeds, %):", ""]
     bins = list(results["models"][0]["summary"]["by_moved"]) if results["models"] else []
     rows += ["| model | " + " | ".join(bins) + " |", "|---|" + "---|" * len(bins)]

@@ -4,16 +4,21 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
+from seannet.data.box_noise import BoxNoise
 from seannet.data.datasets import ImageTransform, TripletDataset, open_dataset
 from seannet.data.moved import moved_objects
+from seannet.errors import DataError
+from seannet.evaluation.box_overlap import SlotBoxes, choose_box_weight
 from seannet.evaluation.metrics import (
     MAX_OFFSET,
+    Embeddings,
     choose_threshold,
     embed_split,
     example_groups,
@@ -29,29 +34,67 @@ from seannet.training.runs import MODEL_KEYS, restore_run
 from sgdata.errors import SgdataError
 from sgdata.fileio import atomic_write_text, save_png
 
-__all__ = ["evaluate_run", "draw_heatmap"]
+__all__ = ["draw_heatmap", "eval_file", "evaluate_run"]
 
 
-def evaluate_run(run: Path, data: Path, *, split: str = "test", out: Path | None = None) -> dict:
-    """Evaluate ``run/best.pt`` on ``split`` of ``data``; writes ``eval_<split>.*`` files.
+def evaluate_run(
+    run: Path,
+    data: Path,
+    *,
+    split: str = "test",
+    out: Path | None = None,
+    boxes: bool = False,
+    noise: BoxNoise | None = None,
+) -> dict:
+    """Evaluate ``run/best.pt`` on ``split`` of ``data``; writes ``eval_<split><tag>.*`` files.
+
+    Every choice is read off the validation split (epsilon; with ``boxes``, lambda), under
+    the same box noise as ``split``; the split evaluated only gives figures.
+
+    Args:
+        boxes: score pairs ``S + lambda * S_box`` (:mod:`seannet.evaluation.box_overlap`),
+            lambda chosen on val: ``MODEL+boxes``. Tag ``+boxes``.
+        noise: evaluate with the boxes a labeler or detector would give (:class:`BoxNoise`).
+            Tag ``_S<jitter>-P<drop>-Q<spurious>``.
 
     Raises:
         CheckpointError: no checkpoint, or it was trained on another dataset.
-        DataError: the dataset or split is missing.
+        DataError: the dataset or split is missing; ``boxes`` on a dataset with no val split.
     """
     out = out or run
     ds = open_dataset(data)
     # photos: another dataset by design, but the same vocabulary
     restored = restore_run(run, data, keys=MODEL_KEYS if _all_real(ds, split) else None)
     config, model, device, state = restored.config, restored.model, restored.device, restored.state
-    evaluated = embed_split(model, config, data, split, device)
+    evaluated = embed_split(model, config, data, split, device, noise=noise)
     transform = ImageTransform.for_model(config.model.image_size, config.model.image_family)
     triplets = TripletDataset(data, split, transform=transform)
-    metrics = triplet_metrics(evaluated, triplets)
     s_ap, s_an = triplet_similarities(evaluated, triplets)
-    moved = moved_objects(data, split, triplets.obs)
+    val = None
     if "val" in ds.splits:
-        threshold = choose_threshold(embed_split(model, config, data, "val", device))
+        val = (
+            evaluated
+            if split == "val"
+            else embed_split(model, config, data, "val", device, noise=noise)
+        )
+    name, tag = config.model.name + ("+boxes" if boxes else ""), _tag(boxes, noise)
+    choices: dict[str, Any] = {}
+    if boxes:
+        if val is None:
+            raise DataError(f"{data}: +boxes chooses lambda on the val split, and there is none")
+        val_triplets = (
+            triplets if split == "val" else TripletDataset(data, "val", transform=transform)
+        )
+        v_ap, v_an = triplet_similarities(val, val_triplets)
+        b_ap, b_an = _box_overlaps(val, val_triplets)
+        weight, by_weight = choose_box_weight(v_ap, v_an, b_ap, b_an)
+        o_ap, o_an = _box_overlaps(evaluated, triplets)
+        s_ap, s_an = s_ap + weight * o_ap, s_an + weight * o_an
+        choices["box_weight"] = {"lambda": weight, "val_accuracy_by_lambda": by_weight}
+    metrics = triplet_metrics(triplets, s_ap, s_an)
+    moved = moved_objects(data, split, triplets.obs)
+    if val is not None:
+        threshold = choose_threshold(val)
         rule = "max balanced accuracy, same pose vs one step (val)"
     else:  # a real dataset holds one split: choosing epsilon on it would grade its own choice
         threshold = {"epsilon": float("nan"), "balanced_accuracy": float("nan")}
@@ -60,10 +103,13 @@ def evaluate_run(run: Path, data: Path, *, split: str = "test", out: Path | None
     stats = offset_statistics(evaluated)
     result: dict[str, Any] = {
         "run": str(run),
-        "model": config.model.name,
+        "model": name,
         "split": split,
         "epoch": state["epoch"],
+        "noise": asdict(noise) if noise is not None else None,
+        **choices,
         **metrics,
+        # epsilon, retrieval and the offset statistics read the embedding alone
         "threshold": {**threshold, "rule": rule},
         "threshold_on_split": quality,
         "retrieval": map_recall(evaluated),
@@ -74,18 +120,41 @@ def evaluate_run(run: Path, data: Path, *, split: str = "test", out: Path | None
         "offset_count": stats["count"].astype(int).tolist(),
     }
     out.mkdir(parents=True, exist_ok=True)
-    result["examples"] = _examples(evaluated, triplets, out, split, config.model.name)
-    atomic_write_text(out / f"eval_{split}.json", json.dumps(result, indent=2))
-    atomic_write_text(out / f"eval_{split}.md", _markdown(result))
-    save_png(
-        draw_heatmap(stats["mean"], f"{config.model.name}: mean S by offset"),
-        out / f"heat_mean_{split}.png",
-    )
-    save_png(
-        draw_heatmap(stats["std"], f"{config.model.name}: std S by offset"),
-        out / f"heat_std_{split}.png",
-    )
+    if not tag:  # the pictures are the embedding's: drawn once, for the plain evaluation
+        result["examples"] = _examples(evaluated, triplets, out, split, name)
+        save_png(
+            draw_heatmap(stats["mean"], f"{name}: mean S by offset"), out / f"heat_mean_{split}.png"
+        )
+        save_png(
+            draw_heatmap(stats["std"], f"{name}: std S by offset"), out / f"heat_std_{split}.png"
+        )
+    atomic_write_text(out / f"eval_{split}{tag}.json", json.dumps(result, indent=2))
+    atomic_write_text(out / f"eval_{split}{tag}.md", _markdown(result))
     return result
+
+
+def eval_file(run: Path, split: str, *, boxes: bool = False, noise: BoxNoise | None = None) -> Path:
+    """Where :func:`evaluate_run` writes its JSON for these options."""
+    return run / f"eval_{split}{_tag(boxes, noise)}.json"
+
+
+def _tag(boxes: bool, noise: BoxNoise | None) -> str:
+    tag = "+boxes" if boxes else ""
+    if noise is not None and noise.active:
+        tag += f"_{noise.label()}"
+    return tag
+
+
+def _box_overlaps(
+    embeddings: Embeddings, triplets: TripletDataset
+) -> tuple[np.ndarray, np.ndarray]:
+    """S_box(A, P) and S_box(A, N) of every triplet, from the boxes the model saw."""
+    assert embeddings.slot_boxes is not None  # embed_split always fills it
+    slot_boxes = SlotBoxes(embeddings.obs_ids, *embeddings.slot_boxes, embeddings.num_slots)
+    anchors, positives, negatives = (
+        zip(*triplets.obs, strict=True) if triplets.obs else ((), (), ())
+    )
+    return slot_boxes.overlap(anchors, positives), slot_boxes.overlap(anchors, negatives)
 
 
 def _all_real(ds, split: str) -> bool:  # noqa: ANN001

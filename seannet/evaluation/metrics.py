@@ -24,7 +24,14 @@ import numpy as np
 import torch
 from torch.utils.data import DataLoader
 
-from seannet.data.datasets import ImageTransform, ObservationDataset, TripletDataset, collate_views
+from seannet.data.box_noise import BoxNoise
+from seannet.data.datasets import (
+    ImageTransform,
+    ObservationDataset,
+    TripletDataset,
+    collate_views,
+    open_dataset,
+)
 from seannet.model.loss import similarity
 from seannet.training.config import TrainConfig
 from seannet.training.loop import collect, embed_batch
@@ -56,19 +63,29 @@ class Embeddings:
     grid_i: np.ndarray  # (N,) int
     grid_j: np.ndarray
     heading: np.ndarray
+    # every view's objects as the model saw them: (offsets (N + 1,), slots, boxes (K, 4))
+    slot_boxes: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+    num_slots: int = 0
 
     def index(self) -> dict[str, int]:
         return {o: k for k, o in enumerate(self.obs_ids)}
 
 
 def embed_split(
-    model: torch.nn.Module, config: TrainConfig, data: Path, split: str, device: torch.device
+    model: torch.nn.Module,
+    config: TrainConfig,
+    data: Path,
+    split: str,
+    device: torch.device,
+    *,
+    noise: BoxNoise | None = None,
 ) -> Embeddings:
-    """Embed every observation of ``split`` once (eval mode)."""
+    """Embed every observation of ``split`` once (eval mode), its boxes under ``noise``."""
     dataset = ObservationDataset(
         data,
         split,
         transform=ImageTransform.for_model(config.model.image_size, config.model.image_family),
+        noise=noise,
     )
     loader = DataLoader(
         dataset,
@@ -95,6 +112,8 @@ def embed_split(
         grid_i=np.array(meta["grid_i"]),
         grid_j=np.array(meta["grid_j"]),
         heading=np.array(meta["heading"]),
+        slot_boxes=dataset.slot_boxes(),
+        num_slots=int(open_dataset(data).manifest.num_slots),
     )
 
 
@@ -110,9 +129,8 @@ def triplet_similarities(
     return np.einsum("ij,ij->i", v[a], v[p]), np.einsum("ij,ij->i", v[a], v[n])
 
 
-def triplet_metrics(embeddings: Embeddings, triplets: TripletDataset) -> dict[str, Any]:
-    """Accuracy overall, per room and per tier, from the split's embeddings."""
-    s_ap, s_an = triplet_similarities(embeddings, triplets)
+def triplet_metrics(triplets: TripletDataset, s_ap: np.ndarray, s_an: np.ndarray) -> dict[str, Any]:
+    """Accuracy overall, per room and per tier, from each triplet's S(A, P) and S(A, N)."""
     correct = s_ap > s_an
     rooms = np.array(triplets.room_ids)
     tiers = np.asarray(triplets.tiers)

@@ -1,10 +1,11 @@
-"""seannet compare: lr chosen on val, seeds summarised with intervals, budget calibrated."""
+"""seannet compare: every choice on val, selection written before test is read, intervals over
+rooms and seeds, budget calibrated."""
 
 from __future__ import annotations
 
 import json
-import math
 import re
+import shutil
 from pathlib import Path
 
 import pytest
@@ -12,14 +13,15 @@ import torch
 
 from seannet.errors import ModelError
 from seannet.evaluation.compare import (
+    SELECTION,
     calibrate_batches,
     compare_models,
     model_spec,
-    paired_difference,
 )
-from seannet.model.backbones import LITE0_WEIGHTS
 from seannet.training.config import TrainConfig
 from seannet.training.runs import build_for_dataset as compare_build
+from seannet.weights import LITE0_WEIGHTS
+from sgdata.dataset import Dataset
 
 TINY = TrainConfig().replace(
     depth=18,
@@ -34,48 +36,58 @@ TINY = TrainConfig().replace(
 )
 
 
-def test_compare_sweeps_lr_and_summarises_seeds(tmp_path: Path, mini_dataset: Path) -> None:
+def test_compare_selects_on_val_before_reading_test(tmp_path: Path, mini_dataset: Path) -> None:
+    # the test split is not there until the selection is written: a read of it before then
+    # fails the whole comparison
+    data = tmp_path / "data"
+    shutil.copytree(mini_dataset, data)
+    hidden = tmp_path / "hidden"
+    hidden.mkdir()
+    test_files = [data / "triplets" / "test.parquet", data / "observations" / "test"]
+    for path in test_files:
+        path.rename(hidden / path.name)
+    seen: dict = {}
+
+    def reveal_test(selection: Path) -> None:
+        seen.update(json.loads(selection.read_text()))
+        for path in test_files:
+            (hidden / path.name).rename(path)
+
     out = tmp_path / "cmp"
     result = compare_models(
-        mini_dataset,
+        data,
         out,
-        ["resnet18", "seannet-graph"],
+        ["resnet18", "resnet18+boxes", "seannet-graph"],
         preset=TINY,
         seeds=(0, 1),
         lrs=(0.01, 0.03),
+        on_selected=reveal_test,
     )
-    saved = json.loads((out / "comparison.json").read_text())
-    assert [e["model"] for e in saved["models"]] == ["resnet18", "seannet-graph"]
-    for entry in result["models"]:
-        assert entry["lr"] in (0.01, 0.03)
-        assert set(entry["val_accuracy_by_lr"]) == {"0.01", "0.03"}
+    assert [m["model"] for m in seen["models"]] == ["resnet18", "resnet18+boxes", "seannet-graph"]
+    assert json.loads((out / SELECTION).read_text()) == seen
+    for choice, entry in zip(seen["models"], result["models"], strict=True):
+        # the chosen lr is the one with the best accuracy on the *whole* val split
+        by_lr = choice["val_accuracy_by_lr"]
+        best = max(by_lr.values())
+        assert choice["lr"] == min(float(k) for k, v in by_lr.items() if v == best)
+        tag = "+boxes" if choice["model"].endswith("+boxes") else ""
+        val = json.loads((Path(choice["runs"][0]) / f"eval_val{tag}.json").read_text())
+        # every val triplet of the dataset, not a subset
+        assert val["triplets"] == Dataset.open(data).triplets("val").num_rows
+        assert by_lr[f"{choice['lr']:g}"] == val["accuracy"]
         summary = entry["summary"]
         assert summary["accuracy"]["n"] == 2 and summary["triplets"] == 10
-        assert not math.isnan(summary["accuracy"]["ci95"])
-        assert set(summary["by_moved"]) == {"0", "1-2", "3-5", "6+"}
-        # the chosen lr's seed-0 run is the sweep's: seeds reuse it
-        assert (out / entry["model"] / f"lr{entry['lr']:g}" / "seed1" / "best.pt").exists()
-    table = (out / "comparison.md").read_text()
-    assert "| resnet18 |" in table
-    difference = saved["models"][1]["difference_to_first"]
+        assert summary["two_level"]["low"] <= summary["two_level"]["mean"]
+        assert summary["two_level"]["mean"] <= summary["two_level"]["high"]
+    # +boxes shares the network's runs, and chose its lambda on val
+    plain, boxes = seen["models"][0], seen["models"][1]
+    assert all(Path(r).parent.parent.name == "resnet18" for r in plain["runs"] + boxes["runs"])
+    assert "box_weight" in result["models"][1]["runs"][0]
+    difference = result["models"][2]["difference_to_first"]
     assert difference["low"] <= difference["mean"] <= difference["high"]
-    assert f"- seannet-graph: {100 * difference['mean']:+.1f} points" in table
-
-
-def test_paired_difference_weights_rooms_and_brackets_the_gap() -> None:
-    def runs(*per_room: dict[str, float]) -> list[dict]:
-        return [{"per_room": rooms} for rooms in per_room]
-
-    counts = {"a": 10, "b": 30, "c": 20}
-    better = runs({"a": 1.0, "b": 0.6, "c": 0.9}, {"a": 0.8, "b": 0.6, "c": 0.7})
-    worse = runs({"a": 0.5, "b": 0.5, "c": 0.5})
-    d = paired_difference(better, worse, counts)
-    # seeds averaged per room (0.9, 0.6, 0.8), minus 0.5, weighted 10 / 30 / 20
-    assert d["mean"] == pytest.approx((0.4 * 10 + 0.1 * 30 + 0.3 * 20) / 60)
-    assert 0.0 < d["low"] < d["mean"] < d["high"] <= 0.4 and d["rooms"] == 3
-    same = paired_difference(worse, worse, counts)
-    assert same["mean"] == same["low"] == same["high"] == 0.0
-    assert paired_difference(better, worse, counts) == d  # a fixed resampling seed
+    assert set(difference["seeds_t"]) == {"mean", "low", "high"}
+    table = (out / "comparison.md").read_text()
+    assert "| resnet18+boxes |" in table and "| seannet-graph |" in table
 
 
 def test_budget_buys_batches(mini_dataset: Path) -> None:
@@ -85,25 +97,31 @@ def test_budget_buys_batches(mini_dataset: Path) -> None:
 
 
 def test_model_specs_name_network_and_imagenet_init() -> None:
-    config, weights = model_spec("seannet@lite0+imagenet", TINY)
-    assert (config.model.name, config.model.backbone, weights) == (
+    spec = model_spec("seannet@lite0+imagenet", TINY)
+    assert (spec.config.model.name, spec.config.model.backbone, spec.pretrained) == (
         "seannet",
         "efficientnet_lite0",
         Path(LITE0_WEIGHTS),
     )
-    config, weights = model_spec("seannet-graph@lite0", TINY)
-    assert (config.model.name, config.model.backbone, weights) == (
+    spec = model_spec("seannet-graph@lite0", TINY)
+    assert (spec.config.model.name, spec.config.model.backbone, spec.pretrained) == (
         "seannet-graph",
         "efficientnet_lite0",
         None,
     )
-    config, weights = model_spec("efficientnet_lite0+imagenet", TINY)
-    assert (config.model.name, config.model.image_family, weights) == (
+    spec = model_spec("efficientnet_lite0+imagenet", TINY)
+    assert (spec.config.model.name, spec.config.model.image_family, spec.pretrained) == (
         "efficientnet_lite0",
         "efficientnet_lite0",
         Path(LITE0_WEIGHTS),
     )
-    assert model_spec("resnet18", TINY)[0].model.backbone == "resnet"
+    assert model_spec("resnet18", TINY).config.model.backbone == "resnet"
+    boxes = model_spec("resnet18+boxes", TINY)
+    assert (boxes.trained, boxes.boxes, boxes.config) == (
+        "resnet18",
+        True,
+        model_spec("resnet18", TINY).config,
+    )
 
 
 @pytest.mark.parametrize(
