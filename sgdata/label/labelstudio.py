@@ -14,6 +14,7 @@ import json
 import re
 from dataclasses import dataclass
 from pathlib import Path
+from urllib.parse import quote
 
 from sgdata.label.annotations import (
     FieldReader,
@@ -203,6 +204,7 @@ def export_labelstudio(
     """
     from sgdata.dataset import Dataset, observations_schema, read_table
     from sgdata.fileio import atomic_write_bytes, atomic_write_text, prepare_output_dir
+    from sgdata.label.export import FILE_SEP
     from sgdata.label.proposals import RELATION_NAMES
 
     out_file = Path(out_file)
@@ -226,7 +228,7 @@ def export_labelstudio(
     for split in ds.splits:
         for shard in ds.observation_files(split):
             for row in read_table(shard, observations_schema(), columns=columns).to_pylist():
-                name = row["obs_id"].replace("/", "__") + (
+                name = row["obs_id"].replace("/", FILE_SEP) + (
                     ".jpg" if row["image_format"] == "jpeg" else ".png"
                 )
                 atomic_write_bytes(images_dir / name, row["image"])
@@ -246,7 +248,8 @@ def export_labelstudio(
                             }
                         )
                         summary.relations += 1
-                data = {TO_NAME: name, **{k: row[k] for k in columns[:8]}}
+                # a reference, as Label Studio gives it: '#', '?', '%' must not end the path
+                data = {TO_NAME: quote(name), **{k: row[k] for k in columns[:8]}}
                 tasks.append(
                     {
                         "id": len(tasks) + 1,
