@@ -50,7 +50,7 @@ def read_labelstudio(path: Path) -> tuple[list[ForeignPhoto], list[str]]:
     tasks = read_json(path)
     tasks = [tasks] if isinstance(tasks, dict) else f.items(tasks, "top level")
     photos, notes = [], []
-    skipped = 0
+    skipped, next_id = 0, 0  # ids of boxes without sgdata's o<instance> ids run across tasks
     for t, task in enumerate(tasks):
         where = f"[{t}]"
         task = f.obj(task, where)
@@ -69,7 +69,10 @@ def read_labelstudio(path: Path) -> tuple[list[ForeignPhoto], list[str]]:
             notes.append(f"task {where}: {len(chosen)} annotations; read the first")
         if chosen:
             k, annotation = chosen[0]
-            skipped += _read_results(f, annotation, f"{where}.annotations[{k}]", photo)
+            more, next_id = _read_results(
+                f, annotation, f"{where}.annotations[{k}]", photo, next_id
+            )
+            skipped += more
         photos.append(photo)
     if skipped:
         notes.append(
@@ -102,8 +105,11 @@ def _read_meta(f: FieldReader, data: dict, where: str, photo: ForeignPhoto) -> N
         }
 
 
-def _read_results(f: FieldReader, annotation: dict, where: str, photo: ForeignPhoto) -> int:
-    """Boxes and relations of one annotation into ``photo``; returns how many were skipped."""
+def _read_results(
+    f: FieldReader, annotation: dict, where: str, photo: ForeignPhoto, next_id: int
+) -> tuple[int, int]:
+    """Boxes and relations of one annotation into ``photo``, new box ids from ``next_id``;
+    returns how many results were skipped, and the next free id."""
     results = f.get(annotation, "result", where, "list")
     rects, relations, skipped = [], [], 0
     for k, result in enumerate(results):
@@ -123,7 +129,7 @@ def _read_results(f: FieldReader, annotation: dict, where: str, photo: ForeignPh
         rid = f.get(result, "id", at, "str")
         if rid in ids:
             raise f.fail(f"{at}.id", f"an id no other result has, not {rid!r} again")
-        ids[rid] = int(matches[n].group(1)) if reuse else n
+        ids[rid] = int(matches[n].group(1)) if reuse else next_id + n
         photo.boxes.append(_rectangle(f, result, at, ids[rid], photo))
     for at, result in relations:
         ends = []
@@ -141,7 +147,7 @@ def _read_results(f: FieldReader, annotation: dict, where: str, photo: ForeignPh
         src, dst = ends if direction != "left" else ends[::-1]
         label = labels[0] if labels else ""
         photo.relations.append(ForeignRelation(src, dst, label, direction == "bi", at))
-    return skipped
+    return skipped, next_id + (0 if reuse else len(rects))
 
 
 def _rectangle(f: FieldReader, result: dict, at: str, oid: int, photo: ForeignPhoto) -> ForeignBox:

@@ -32,7 +32,7 @@ def test_export_writes_real_rows_that_validate(photos_dir: Path, tmp_path: Path)
     relations = [{"src": 1, "dst": 0, "type": "on"}]
     store.save("a.png", _labels(objects=objects, relations=relations))
     store.save(
-        "c.jpg", _labels(objects=[{"id": 0, "class_name": "Chair", "box": [10, 10, 150, 90]}])
+        "c.jpg", _labels(objects=[{"id": 4, "class_name": "Chair", "box": [10, 10, 150, 90]}])
     )
     store.save("b.png", PhotoLabels())  # no room id: left out
 
