@@ -7,39 +7,16 @@ import subprocess
 from pathlib import Path
 
 import pyarrow.parquet as pq
-import pytest
 
 from sgdata.validate import validate_dataset
 
+from .browser import ARGS, CHROMIUM, needs_chromium
+from .browser import drag as _drag
+from .browser import saved as _saved
 from .conftest import make_photo
 from .server_process import SGDATA, label_server
 
-CHROMIUM = "/usr/bin/chromium"
-ARGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--no-first-run",
-]
-pytestmark = pytest.mark.skipif(not Path(CHROMIUM).exists(), reason="needs Debian's chromium")
-
-
-def _drag(page, box: list[int], photo_size: tuple[int, int]) -> None:
-    """Draw ``box`` (image pixels) with the mouse on the overlay."""
-    r = page.locator("#overlay").bounding_box()
-    sx, sy = r["width"] / photo_size[0], r["height"] / photo_size[1]
-    page.mouse.move(r["x"] + box[0] * sx, r["y"] + box[1] * sy)
-    page.mouse.down()
-    page.mouse.move(r["x"] + (box[0] + box[2]) / 2 * sx, r["y"] + (box[1] + box[3]) / 2 * sy)
-    page.mouse.move(r["x"] + box[2] * sx, r["y"] + box[3] * sy)
-    page.mouse.up()
-
-
-def _saved(page) -> None:
-    page.wait_for_selector('#status[data-state="saved"]')
+pytestmark = needs_chromium
 
 
 def test_label_two_photos_in_the_browser_and_export(tmp_path: Path) -> None:
