@@ -156,3 +156,30 @@ def test_ready_marker_counts_photos_ready_to_export(tmp_path: Path) -> None:
         assert page.locator("#ready-count").inner_text() == "1/2 ready to export"
         assert page.locator("#ready").inner_text() == "ready to export"
         assert page.failed == []  # no 404 (favicon) nor any refused request
+
+
+def test_cup_on_a_saucer_photo_proposes_on(tmp_path: Path) -> None:
+    """scikit-image's coffee photo (CC0), labelled as a person would; the docs' screenshot."""
+    import os
+    import shutil
+
+    import skimage.data
+
+    photos, out = tmp_path / "photos", tmp_path / "ds"
+    photos.mkdir()
+    shutil.copy(Path(skimage.data.__file__).parent / "coffee.png", photos / "coffee.png")
+    size = (600, 400)
+    with labeling_page(photos, out, viewport=(1280, 560)) as page:
+        set_room(page, "cafe_1", "kitchen")
+        box_with_class(page, [76, 70, 480, 388], size, "Plate")  # the saucer
+        box_with_class(page, [172, 18, 410, 308], size, "Cup")
+        box_with_class(page, [325, 66, 425, 326], size, "Spoon")
+        cup_on_saucer = page.locator('#arrows .rel[data-src="1"][data-dst="0"]')
+        assert cup_on_saucer.get_attribute("data-type") == "on"
+        cup_on_saucer.locator("text.hit").click()
+        page.keyboard.press("Enter")
+        page.wait_for_selector('#arrows .rel[data-src="1"][data-status="accepted"]')
+        saved(page)
+        page.locator('#box-list li[data-id="1"]').click()  # show a selected box
+        if os.environ.get("SGDATA_LABEL_SCREENSHOT"):
+            page.screenshot(path=os.environ["SGDATA_LABEL_SCREENSHOT"])
