@@ -183,3 +183,67 @@ def test_cup_on_a_saucer_photo_proposes_on(tmp_path: Path) -> None:
         page.locator('#box-list li[data-id="1"]').click()  # show a selected box
         if os.environ.get("SGDATA_LABEL_SCREENSHOT"):
             page.screenshot(path=os.environ["SGDATA_LABEL_SCREENSHOT"])
+
+
+def test_a_day_of_work_twenty_phone_photos_of_one_room(tmp_path: Path) -> None:
+    """20 phone-sized photos of one room without a reload: carry over, move, fast undo/redo."""
+    import subprocess
+
+    import pyarrow.parquet as pq
+
+    from sgdata.validate import validate_dataset
+
+    from .server_process import SGDATA
+
+    photos, out = tmp_path / "photos", tmp_path / "ds"
+    photos.mkdir()
+    size = (4032, 3024)
+    for k in range(20):
+        image = Image.new("RGB", size, (170 + k, 160, 150))
+        ImageDraw.Draw(image).rectangle([500, 1500, 3500, 2900], fill=(110, 70, 40))
+        image.save(photos / f"IMG_{k:04d}.jpg", quality=85)
+    with labeling_page(photos, out, init=SLOW_SAVES) as page:
+        set_room(page, "kitchen_home", "kitchen")
+        box_with_class(page, [500, 1500, 3500, 2900], size, "DiningT")
+        box_with_class(page, [1500, 1000, 2000, 1600], size, "Mug")
+        page.locator("#stage").focus()
+        page.keyboard.press("Tab")
+        page.keyboard.press("Enter")  # mug on table
+        for k in range(1, 20):
+            page.keyboard.press("ArrowRight")
+            page.wait_for_selector(f'body[data-photo="IMG_{k:04d}.jpg"]')
+            page.keyboard.press("c")  # an empty photo: no question asked
+            page.wait_for_selector('#box-list li[data-id="1"]')
+            page.locator('#box-list li[data-id="1"]').click()
+            r = page.locator("#overlay").bounding_box()
+            sx = r["width"] / size[0]
+            centre = 1750 + 5 * (k - 1) * k  # where the carried-over mug is now
+            x, y = r["x"] + centre * sx, r["y"] + 1300 * sx
+            page.mouse.move(x, y)
+            page.mouse.down()
+            page.mouse.move(x + 10 * k * sx, y)
+            page.mouse.up()
+            page.keyboard.press("Control+z")
+            page.keyboard.press("Control+y")
+        page.wait_for_timeout(1500)
+        saved(page)
+        assert page.locator("#ready-count").inner_text() == "20/20 ready to export"
+    done = subprocess.run(
+        [SGDATA, "label", str(photos), "--out", str(out), "--export"],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stderr
+    assert "undecided" not in done.stdout
+    report = validate_dataset(out)
+    assert report.ok, report.problems
+    rows = pq.read_table(out / "observations/test/kitchen_home.parquet").to_pylist()
+    assert len(rows) == 20
+    for row in rows:
+        k = int(row["obs_id"][-4:])
+        mug = row["objects"][1]
+        assert [o["class_name"] for o in row["objects"]] == ["DiningTable", "Mug"]
+        # each photo carries the last one's mug over and moves it 10 k px further right
+        assert abs(mug["box2d"][0] - (1500 + 5 * k * (k + 1))) <= 2 * k + 1  # every move kept
+        assert [(r["src"], r["dst"], r["type"]) for r in row["relations"]] == [(1, 0, 0)]
