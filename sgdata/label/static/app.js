@@ -38,7 +38,11 @@ async function refreshList() {
   for (const s of r.body.skipped) {
     const li = document.createElement("li"); li.textContent = `${s.name}: ${s.reason}`; ul.append(li);
   }
-  $("#skipped-box").hidden = r.body.skipped.length === 0;
+  // Skipped files are problems to see while labeling (a truncated or oversized photo): say how many.
+  const box = $("#skipped-box"), count = r.body.skipped.length;
+  if (count > Number(box.dataset.count || 0)) box.open = true;
+  box.dataset.count = count; box.hidden = count === 0;
+  $("#skipped-box summary").textContent = `${count} skipped file(s)`;
   renderList();
 }
 function renderList() {

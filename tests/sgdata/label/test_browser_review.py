@@ -247,3 +247,19 @@ def test_a_day_of_work_twenty_phone_photos_of_one_room(tmp_path: Path) -> None:
         # each photo carries the last one's mug over and moves it 10 k px further right
         assert abs(mug["box2d"][0] - (1500 + 5 * k * (k + 1))) <= 2 * k + 1  # every move kept
         assert [(r["src"], r["dst"], r["type"]) for r in row["relations"]] == [(1, 0, 0)]
+
+
+def test_undecodable_photo_is_shown_with_its_reason(tmp_path: Path) -> None:
+    photos, out = _photos(tmp_path, "p1.png"), tmp_path / "ds"
+    make_photo(photos / "whole.jpg", *SIZE, seed=5)
+    data = (photos / "whole.jpg").read_bytes()
+    (photos / "cut.jpg").write_bytes(data[: len(data) * 2 // 3])
+    (photos / "whole.jpg").unlink()
+    with labeling_page(photos, out) as page:
+        assert page.locator("#skipped-box").get_attribute("open") is not None  # shown, not folded
+        assert page.locator("#skipped-box summary").inner_text() == "1 skipped file(s)"
+        text = page.locator("#skipped").inner_text()
+        assert text.startswith("cut.jpg: cannot be decoded (image file is truncated")
+        assert [p.get_attribute("data-name") for p in page.locator("#photos li").all()] == [
+            "p1.png"
+        ]
