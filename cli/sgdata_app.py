@@ -346,8 +346,7 @@ def label(
         int | None,
         typer.Option(
             "--max-pixels",
-            help="Largest photo to open, in pixels (default 178,956,970: a decompression-bomb "
-            "guard).",
+            help="Largest photo to open, in pixels (default: Pillow's decompression-bomb guard).",
         ),
     ] = None,
 ) -> None:

@@ -209,8 +209,8 @@ def create_app(
         try:
             labels = PhotoLabels.model_validate_json(json.dumps(raw))
         except ValidationError as exc:
-            problems_ = [f"{'.'.join(map(str, e['loc']))}: {e['msg']}" for e in exc.errors()]
-            return JSONResponse({"detail": problems_}, status_code=422)
+            errors = [f"{'.'.join(map(str, e['loc']))}: {e['msg']}" for e in exc.errors()]
+            return JSONResponse({"detail": errors}, status_code=422)
         w, h = found.width, found.height
         outside = [o.id for o in labels.objects if o.box[2] > w or o.box[3] > h]
         if outside:
