@@ -3,14 +3,18 @@
 from __future__ import annotations
 
 import os
+import socket
 from pathlib import Path
 
+import httpx
 import pytest
 from fastapi.testclient import TestClient
 
 from sgdata.errors import ConfigError
 from sgdata.label.classes import load_class_names
 from sgdata.label.server import MAX_BODY, create_app, host_name
+
+from .server_process import label_server
 
 GOOD = {"room_id": "k1", "room_type": "kitchen", "objects": [], "relations": []}
 
@@ -71,6 +75,23 @@ def test_foreign_host_is_refused(client: TestClient) -> None:
 @pytest.mark.parametrize("host", ["[::1]:8765", "[::1]", "127.0.0.1:8765", "localhost"])
 def test_loopback_hosts_are_answered(client: TestClient, host: str) -> None:
     assert client.get("/api/photos", headers={"Host": host}).status_code == 200
+
+
+def _ipv6_loopback() -> bool:
+    try:
+        with socket.socket(socket.AF_INET6) as s:
+            s.bind(("::1", 0))
+        return True
+    except OSError:
+        return False
+
+
+@pytest.mark.skipif(not _ipv6_loopback(), reason="this machine has no IPv6 loopback")
+def test_a_server_on_ipv6_loopback_answers(photos_dir: Path, tmp_path: Path) -> None:
+    with label_server(photos_dir, tmp_path / "ds", host="::1") as (url, _):
+        assert url.startswith("http://[::1]:")
+        assert httpx.get(url + "/api/photos").status_code == 200
+        assert httpx.get(url + "/api/photos", headers={"Host": "evil.example"}).status_code == 400
 
 
 def test_host_name_reads_bracketed_ipv6() -> None:
