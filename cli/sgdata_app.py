@@ -343,12 +343,25 @@ def label(
         bool, typer.Option("--export", help="Write the labels as a real dataset and exit.")
     ] = False,
     split: Annotated[str, typer.Option(help="Split of the exported rooms.")] = "test",
+    max_pixels: Annotated[
+        int | None,
+        typer.Option(
+            "--max-pixels",
+            help="Largest photo to open, in pixels (default: Pillow's decompression-bomb guard).",
+        ),
+    ] = None,
 ) -> None:
-    """Label real photos in a local web page (boxes, classes, relations), or --export them."""
+    """Label real photos in a local web page (boxes, classes, relations), or --export them.
+
+    A --classes map is remembered beside the labels: later runs and --export use it.
+    """
+    from sgdata.label.photos import DEFAULT_MAX_PIXELS
+
+    pixels = max_pixels or DEFAULT_MAX_PIXELS
     if export:
         from sgdata.label.export import export_dataset
 
-        done = export_dataset(photos, out, class_map=classes, split=split)
+        done = export_dataset(photos, out, class_map=classes, split=split, max_pixels=pixels)
         console.print(
             f"wrote {done.observations} observation(s) of {done.rooms} room(s) and "
             f"{done.triplets} triplet(s) to {done.root} (split {done.split})"
@@ -356,7 +369,12 @@ def label(
         if done.unlabeled:
             console.print(f"left out {len(done.unlabeled)} photo(s) without a room id")
         if done.pending:
-            console.print(f"{done.pending} undecided proposal(s) stored as disjoint")
+            where = ", ".join(f"{name} ({n})" for name, n in done.pending.items())
+            console.print(
+                f"{sum(done.pending.values())} undecided proposal(s) stored as disjoint: "
+                f"{where}; decide them in the page (Tab, then Enter / O / I / P / D)",
+                markup=False,
+            )
         for note in done.notes:
             console.print(note, markup=False)
         return
@@ -368,6 +386,7 @@ def label(
         host=host,
         port=port,
         class_map=classes,
+        max_pixels=pixels,
         on_ready=lambda url: console.print(f"labeling {photos} at {url} (Ctrl-C stops)"),
     )
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import difflib
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -18,6 +19,9 @@ class ClassNames:
 
     catalog: tuple[str, ...]
     mapped: dict[str, str] = field(default_factory=dict)
+    # catalog classes others rest *inside* (some class lists them as `containers`): the only
+    # ones a contained box is proposed to be `in`
+    containers: frozenset[str] = frozenset()
 
     def resolve(self, name: str) -> str | None:
         """The catalog class a typed name stands for; None when unknown."""
@@ -28,6 +32,22 @@ class ClassNames:
     def all_names(self) -> list[str]:
         """Every name the page offers: catalog classes, then mapped names."""
         return [*self.catalog, *(n for n in self.mapped if n not in self.catalog)]
+
+    def closest(self, name: str, n: int = 3) -> list[str]:
+        """Up to ``n`` offered names most like ``name`` (ignoring case), best first."""
+        by_lower = {x.lower(): x for x in self.all_names()}
+        near = difflib.get_close_matches(name.lower(), list(by_lower), n=n, cutoff=0.4)
+        return [by_lower[x] for x in near]
+
+    def unknown(self, name: str) -> str:
+        """The one-line message for a typed name that is neither a class nor mapped."""
+        near = self.closest(name)
+        hint = f"closest: {', '.join(near)}; " if near else ""
+        target = near[0] if near else "CatalogClass"
+        return (
+            f"unknown class {name!r}; {hint}pick one, or map the name in a --classes TOML file "
+            f'(a line "{name}" = "{target}") and restart `sgdata label` with it'
+        )
 
 
 def load_class_names(class_map: Path | None = None, catalog: Catalog | None = None) -> ClassNames:
@@ -41,8 +61,9 @@ def load_class_names(class_map: Path | None = None, catalog: Catalog | None = No
     """
     catalog = catalog or load_catalog()
     names = tuple(catalog.names())
+    containers = frozenset(c for n in names for c in catalog[n].containers)
     if class_map is None:
-        return ClassNames(names)
+        return ClassNames(names, containers=containers)
     path = Path(class_map)
     try:
         raw = tomllib.loads(path.read_text(encoding="utf-8"))
@@ -66,4 +87,4 @@ def load_class_names(class_map: Path | None = None, catalog: Catalog | None = No
         if not name.strip():
             raise ConfigError(f"{path}: an empty class name; expected a name to type")
         mapped[name] = target
-    return ClassNames(names, mapped)
+    return ClassNames(names, mapped, containers)

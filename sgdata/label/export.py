@@ -5,7 +5,9 @@ split, images stored as the photo's own bytes (see :func:`sgdata.label.photos.ph
 3D boxes, obb and support null, ``visible_pixels`` the box area (a photo has no instance mask),
 and every pair of objects without an accepted relation stored as ``disjoint`` both ways, as
 the generator stores it. Photos with a pose get ``<room>/<layout>/<i>/<j>/<heading>`` ids and
-take part in cascaded triplets; the others get ``<room>/<photo stem>`` ids.
+take part in cascaded triplets; the others get ``<room>/<photo stem>`` ids (a stem that starts
+with ``<room>__``, as the Label Studio export names its image files, drops that prefix, so a
+round trip through Label Studio keeps the id).
 """
 
 from __future__ import annotations
@@ -21,15 +23,16 @@ from sgdata.dataset.paths import MANIFEST, OUTPUTS, SPLITS, obs_id, observations
 from sgdata.errors import ConfigError, DatasetError
 from sgdata.label.classes import ClassNames, load_class_names
 from sgdata.label.models import PhotoLabels
-from sgdata.label.photos import Photo, photo_bytes, scan_photos
+from sgdata.label.photos import DEFAULT_MAX_PIXELS, Photo, photo_bytes, scan_photos
 from sgdata.label.proposals import DEFAULT_RULES, RELATION_NAMES, ProposalRules
 from sgdata.label.store import LabelStore
 from sgdata.world.triplets import RoomPoses, Triplet, sample_triplets
 
-__all__ = ["ExportSummary", "export_dataset", "SOURCE"]
+__all__ = ["ExportSummary", "export_dataset", "SOURCE", "FILE_SEP"]
 
 SOURCE = "sgdata label"  # config.source of an export: re-exporting may replace only these
 HEADINGS = 4
+FILE_SEP = "__"  # stands for the '/' of an obs_id in a file name (Label Studio image files)
 
 
 @dataclass
@@ -42,7 +45,7 @@ class ExportSummary:
     observations: int = 0
     triplets: int = 0
     unlabeled: list[str] = field(default_factory=list)  # photos without a room id (left out)
-    pending: int = 0  # proposals never decided, stored as disjoint
+    pending: dict[str, int] = field(default_factory=dict)  # photo -> proposals never decided
     dropped: int = 0  # objects beyond their class's slot run
     notes: list[str] = field(default_factory=list)
 
@@ -63,9 +66,12 @@ def export_dataset(
     name: str = "real",
     version: str = "1.0.0",
     rules: ProposalRules = DEFAULT_RULES,
+    max_pixels: int = DEFAULT_MAX_PIXELS,
 ) -> ExportSummary:
     """Write the labeled photos of ``photos_dir`` (labels under ``out_dir/labels``) as a
     dataset in ``out_dir``: observation shards, triplet tables where poses allow, manifest.
+
+    ``class_map`` defaults to the one ``sgdata label --classes`` remembered beside the labels.
 
     Raises:
         ConfigError: a bad split, class map or photos directory, or ``out_dir`` holds a
@@ -73,13 +79,14 @@ def export_dataset(
         DatasetError: a label names an unknown class, or two photos get the same id.
     """
     from sgdata.dataset.vocabulary import class_vocabulary
-    from sgdata.label.proposals import propose_relations
+    from sgdata.label.review import proposals_for, undecided
 
     if split not in SPLITS:
         raise ConfigError(f"--split {split!r}: expected one of {', '.join(SPLITS)}")
-    classes = load_class_names(class_map)
-    index = scan_photos(photos_dir)
     store = LabelStore(out_dir)
+    class_map = store.class_map(class_map)
+    classes = load_class_names(class_map)
+    index = scan_photos(photos_dir, max_pixels=max_pixels)
     root = store.root
     summary = ExportSummary(root, split)
     slots, vocabulary = class_vocabulary()
@@ -95,11 +102,9 @@ def export_dataset(
         if labels.room_id is None:
             summary.unlabeled.append(photo_name)
             continue
-        boxes = {o.id: o.box for o in labels.objects}
-        decided = {(min(r.src, r.dst), max(r.src, r.dst)) for r in labels.relations}
-        summary.pending += sum(
-            (p.src, p.dst) not in decided for p in propose_relations(boxes, rules)
-        )
+        pending = len(undecided(labels, proposals_for(labels, classes, rules)))
+        if pending:
+            summary.pending[photo_name] = pending
         rooms.setdefault(labels.room_id, []).append(_Row(photo, labels, _row_id(photo, labels)))
     _check_rooms(rooms)
 
@@ -159,7 +164,11 @@ def _row_id(photo: Photo, labels: PhotoLabels) -> str:
     if labels.pose is not None:
         p = labels.pose
         return obs_id(labels.room_id, p.layout, p.i, p.j, p.heading)
-    return f"{labels.room_id}/{PurePath(photo.name).stem}"
+    stem = PurePath(photo.name).stem
+    prefix = labels.room_id + FILE_SEP
+    if stem.startswith(prefix) and len(stem) > len(prefix):
+        stem = stem[len(prefix) :]  # a file named by the Label Studio export: no second prefix
+    return f"{labels.room_id}/{stem}"
 
 
 def _check_rooms(rooms: dict[str, list[_Row]]) -> None:

@@ -14,6 +14,7 @@ import json
 import re
 from dataclasses import dataclass
 from pathlib import Path
+from urllib.parse import quote
 
 from sgdata.label.annotations import (
     FieldReader,
@@ -49,7 +50,7 @@ def read_labelstudio(path: Path) -> tuple[list[ForeignPhoto], list[str]]:
     tasks = read_json(path)
     tasks = [tasks] if isinstance(tasks, dict) else f.items(tasks, "top level")
     photos, notes = [], []
-    skipped = 0
+    skipped, next_id = 0, 0  # ids of boxes without sgdata's o<instance> ids run across tasks
     for t, task in enumerate(tasks):
         where = f"[{t}]"
         task = f.obj(task, where)
@@ -68,7 +69,10 @@ def read_labelstudio(path: Path) -> tuple[list[ForeignPhoto], list[str]]:
             notes.append(f"task {where}: {len(chosen)} annotations; read the first")
         if chosen:
             k, annotation = chosen[0]
-            skipped += _read_results(f, annotation, f"{where}.annotations[{k}]", photo)
+            more, next_id = _read_results(
+                f, annotation, f"{where}.annotations[{k}]", photo, next_id
+            )
+            skipped += more
         photos.append(photo)
     if skipped:
         notes.append(
@@ -101,8 +105,11 @@ def _read_meta(f: FieldReader, data: dict, where: str, photo: ForeignPhoto) -> N
         }
 
 
-def _read_results(f: FieldReader, annotation: dict, where: str, photo: ForeignPhoto) -> int:
-    """Boxes and relations of one annotation into ``photo``; returns how many were skipped."""
+def _read_results(
+    f: FieldReader, annotation: dict, where: str, photo: ForeignPhoto, next_id: int
+) -> tuple[int, int]:
+    """Boxes and relations of one annotation into ``photo``, new box ids from ``next_id``;
+    returns how many results were skipped, and the next free id."""
     results = f.get(annotation, "result", where, "list")
     rects, relations, skipped = [], [], 0
     for k, result in enumerate(results):
@@ -122,7 +129,7 @@ def _read_results(f: FieldReader, annotation: dict, where: str, photo: ForeignPh
         rid = f.get(result, "id", at, "str")
         if rid in ids:
             raise f.fail(f"{at}.id", f"an id no other result has, not {rid!r} again")
-        ids[rid] = int(matches[n].group(1)) if reuse else n
+        ids[rid] = int(matches[n].group(1)) if reuse else next_id + n
         photo.boxes.append(_rectangle(f, result, at, ids[rid], photo))
     for at, result in relations:
         ends = []
@@ -140,7 +147,7 @@ def _read_results(f: FieldReader, annotation: dict, where: str, photo: ForeignPh
         src, dst = ends if direction != "left" else ends[::-1]
         label = labels[0] if labels else ""
         photo.relations.append(ForeignRelation(src, dst, label, direction == "bi", at))
-    return skipped
+    return skipped, next_id + (0 if reuse else len(rects))
 
 
 def _rectangle(f: FieldReader, result: dict, at: str, oid: int, photo: ForeignPhoto) -> ForeignBox:
@@ -203,6 +210,7 @@ def export_labelstudio(
     """
     from sgdata.dataset import Dataset, observations_schema, read_table
     from sgdata.fileio import atomic_write_bytes, atomic_write_text, prepare_output_dir
+    from sgdata.label.export import FILE_SEP
     from sgdata.label.proposals import RELATION_NAMES
 
     out_file = Path(out_file)
@@ -226,7 +234,7 @@ def export_labelstudio(
     for split in ds.splits:
         for shard in ds.observation_files(split):
             for row in read_table(shard, observations_schema(), columns=columns).to_pylist():
-                name = row["obs_id"].replace("/", "__") + (
+                name = row["obs_id"].replace("/", FILE_SEP) + (
                     ".jpg" if row["image_format"] == "jpeg" else ".png"
                 )
                 atomic_write_bytes(images_dir / name, row["image"])
@@ -246,7 +254,8 @@ def export_labelstudio(
                             }
                         )
                         summary.relations += 1
-                data = {TO_NAME: name, **{k: row[k] for k in columns[:8]}}
+                # a reference, as Label Studio gives it: '#', '?', '%' must not end the path
+                data = {TO_NAME: quote(name), **{k: row[k] for k in columns[:8]}}
                 tasks.append(
                     {
                         "id": len(tasks) + 1,

@@ -4,11 +4,14 @@ Real photos have no 3D boxes, so DESIGN §5's rules are mirrored in the image pl
 *proposed*; the labeler accepts, retypes or rejects each one. For every unordered pair of boxes
 the first rule that matches wins:
 
-1. ``on``: the smaller box's bottom edge lies in the top band of the larger box (within
-   ``top_band`` of its height below the top edge, or ``top_slack`` above it) and the smaller
-   box's horizontal centre lies over the larger box -> smaller on larger.
-2. ``in``: at least ``inside_share`` of the smaller box's area lies inside the larger box
+1. ``in``: at least ``inside_share`` of the smaller box's area lies inside the larger box, and
+   the larger box is a container (its class is a catalog container: Bowl, SinkBasin, Box ...)
    -> smaller in larger.
+2. ``on``: the smaller box's bottom edge lies in the top part of the larger box (within
+   ``top_band`` of its height below the top edge, or ``top_slack`` above it) and the smaller
+   box's horizontal centre lies over the larger box -> smaller on larger. Seen from above (a
+   cup on a saucer, a book on a desk) the resting object's bottom edge lies anywhere on the
+   supporting surface but its front rim, hence the deep band.
 3. ``proximity``: the centres are no further apart than the sum of the boxes' half diagonals
    times ``proximity_scale`` (the 2D image of §5's bounding-sphere rule) -> symmetric, one
    proposal with ``src < dst``.
@@ -17,7 +20,7 @@ the first rule that matches wins:
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import asdict, dataclass
 
 from sgdata.errors import ConfigError
@@ -41,7 +44,7 @@ RELATION_NAMES = ("on", "in", "proximity", "disjoint")
 class ProposalRules:
     """The knobs of the 2D rules; recorded in an export's ``relation_rules``."""
 
-    top_band: float = 0.35  # share of the larger box's height, below its top edge, that is "top"
+    top_band: float = 0.8  # share of the larger box's height, below its top edge, that is "top"
     top_slack: float = 0.05  # share of the larger box's height above its top edge still "on"
     inside_share: float = 0.9  # share of the smaller box's area inside the larger one for "in"
     proximity_scale: float = 1.0  # x (half diagonal + half diagonal) = farthest "close" centres
@@ -55,7 +58,10 @@ class ProposalRules:
 
     def to_dict(self) -> dict[str, object]:
         """Plain dict for the manifest."""
-        return {"heuristic": "2D first-match on>in>proximity, confirmed by hand", **asdict(self)}
+        return {
+            "heuristic": "2D first-match in (containers only)>on>proximity, confirmed by hand",
+            **asdict(self),
+        }
 
 
 DEFAULT_RULES = ProposalRules()
@@ -102,9 +108,18 @@ def _close(a: Box, b: Box, rules: ProposalRules) -> bool:
 
 
 def propose_pair(
-    a: int, box_a: Box, b: int, box_b: Box, rules: ProposalRules | None = None
+    a: int,
+    box_a: Box,
+    b: int,
+    box_b: Box,
+    rules: ProposalRules | None = None,
+    *,
+    containers: Collection[int] = (),
 ) -> Proposal | None:
-    """The proposal for one pair of boxes, or None (first match of on > in > proximity)."""
+    """The proposal for one pair of boxes, or None (first match of in > on > proximity).
+
+    ``containers`` holds the ids of the boxes whose class is a catalog container.
+    """
     rules = rules or DEFAULT_RULES
     # The smaller box is the candidate for on / in; equal areas: the lower id is the smaller.
     if (_area(box_a), a) <= (_area(box_b), b):
@@ -112,25 +127,29 @@ def propose_pair(
     else:
         small, large = (b, box_b), (a, box_a)
     if _area(small[1]) < _area(large[1]):
+        if large[0] in containers and _inside(small[1], large[1], rules):
+            return Proposal(small[0], large[0], "in")
         if _on(small[1], large[1], rules):
             return Proposal(small[0], large[0], "on")
-        if _inside(small[1], large[1], rules):
-            return Proposal(small[0], large[0], "in")
     if _close(box_a, box_b, rules):
         return Proposal(min(a, b), max(a, b), "proximity")
     return None
 
 
 def propose_relations(
-    boxes: Mapping[int, Box], rules: ProposalRules | None = None
+    boxes: Mapping[int, Box],
+    rules: ProposalRules | None = None,
+    *,
+    containers: Collection[int] = (),
 ) -> list[Proposal]:
-    """Proposals for every pair of ``boxes`` (object id -> box), sorted by (src, dst)."""
+    """Proposals for every pair of ``boxes`` (object id -> box), sorted by (src, dst);
+    ``containers``: the ids of the boxes whose class is a catalog container."""
     rules = rules or DEFAULT_RULES
     ids = sorted(boxes)
     out = []
     for k, a in enumerate(ids):
         for b in ids[k + 1 :]:
-            found = propose_pair(a, boxes[a], b, boxes[b], rules)
+            found = propose_pair(a, boxes[a], b, boxes[b], rules, containers=containers)
             if found is not None:
                 out.append(found)
     return sorted(out, key=lambda p: (p.src, p.dst))

@@ -44,6 +44,9 @@ def read_coco(path: Path) -> tuple[list[ForeignPhoto], list[str]]:
         width, height = f.size(image, where, ("width", "height"))
         photos[image_id] = ForeignPhoto(name, width, height, f"{path}: {where}")
     notes = []
+    # Box ids run across the file: it says nothing of which boxes of two photos are one
+    # object, and an id is one object of a room (one class).
+    next_id = 0
     for k, ann in enumerate(f.get(root, "annotations", "top level", "list")):
         where = f"annotations[{k}]"
         ann = f.obj(ann, where)
@@ -60,7 +63,8 @@ def read_coco(path: Path) -> tuple[list[ForeignPhoto], list[str]]:
             raise f.fail(f"{where}.bbox", "[x, y, width, height] numbers")
         x, y, w, h = bbox
         box = f.box(x, y, x + w, y + h, (photo.width, photo.height), f"{where}.bbox")
-        photo.boxes.append(ForeignBox(len(photo.boxes), categories[category], box, where))
+        photo.boxes.append(ForeignBox(next_id, categories[category], box, where))
+        next_id += 1
     return list(photos.values()), notes
 
 
@@ -77,6 +81,7 @@ def read_labelme(path: Path) -> tuple[list[ForeignPhoto], list[str]]:
     if not files:
         raise AnnotationFormatError(f"{path}: no LabelMe *.json files in this directory")
     photos, skipped = [], 0
+    next_id = 0  # box ids run across the files, as in read_coco
     for file in files:
         f = FieldReader(file)
         root = f.obj(read_json(file), "top level")
@@ -100,7 +105,8 @@ def read_labelme(path: Path) -> tuple[list[ForeignPhoto], list[str]]:
             (x1, y1), (x2, y2) = points
             box = f.box(min(x1, x2), min(y1, y2), max(x1, x2), max(y1, y2), (width, height), where)
             label = f.get(shape, "label", where, "str")
-            photo.boxes.append(ForeignBox(len(photo.boxes), label, box, where))
+            photo.boxes.append(ForeignBox(next_id, label, box, where))
+            next_id += 1
         photos.append(photo)
     notes = [f"skipped {skipped} LabelMe shape(s) that are not rectangles"] if skipped else []
     return photos, notes

@@ -2,11 +2,13 @@
 
 Routes (all same-origin, no CDN)::
 
-    GET /                     the page (static/index.html); /static/app.js, /static/app.css
+    GET /                     the page (static/index.html); /static/app.js, app.css, favicon.svg
     GET /photos/<name>        a photo's bytes, looked up in the index (nothing else is served)
-    GET /api/photos           photos in order, with their room and box counts, and skipped files
+    GET /api/photos           photos in order (rescanned: new files appear), with their room,
+                              box count and what keeps each from export; and skipped files
     GET /api/classes          catalog classes and mapped names, for the type-ahead
-    GET /api/labels/<name>    a photo's labels and the relations proposed from its boxes
+    GET /api/classes/unknown  ?name=...: the message for a name that is no class (closest names)
+    GET /api/labels/<name>    a photo's labels, the relations proposed from its boxes, problems
     PUT /api/labels/<name>    save (JSON, <= 1 MiB, no unknown fields, the revision last seen)
 
 The proposal rules run here (``sgdata.label.proposals``); the page shows what the API returns.
@@ -15,6 +17,7 @@ The proposal rules run here (``sgdata.label.proposals``); the page shows what th
 from __future__ import annotations
 
 import json
+import threading
 from collections.abc import Callable
 from importlib import resources
 from pathlib import Path
@@ -22,12 +25,12 @@ from pathlib import Path
 from fastapi import FastAPI, HTTPException, Request
 from fastapi.responses import FileResponse, JSONResponse, Response
 from pydantic import ValidationError
-from starlette.middleware.trustedhost import TrustedHostMiddleware
 
 from sgdata.label.classes import ClassNames, load_class_names
 from sgdata.label.models import PhotoLabels
-from sgdata.label.photos import PhotoIndex, scan_photos
-from sgdata.label.proposals import DEFAULT_RULES, ProposalRules, propose_relations
+from sgdata.label.photos import DEFAULT_MAX_PIXELS, Photo, scan_photos
+from sgdata.label.proposals import DEFAULT_RULES, ProposalRules
+from sgdata.label.review import problems, proposals_for, room_instances
 from sgdata.label.store import ConflictError, LabelStore
 
 __all__ = ["MAX_BODY", "create_app", "serve"]
@@ -39,6 +42,7 @@ STATIC = {
     "index.html": "text/html; charset=utf-8",
     "app.js": "text/javascript; charset=utf-8",
     "app.css": "text/css; charset=utf-8",
+    "favicon.svg": "image/svg+xml",
 }
 _HEADERS = {"Cache-Control": "no-store", "X-Content-Type-Options": "nosniff"}
 
@@ -49,13 +53,31 @@ def _static(name: str) -> Response:
     return Response(text, media_type=STATIC[name], headers=headers)
 
 
-def _payload(name: str, labels: PhotoLabels, rules: ProposalRules) -> dict:
-    boxes = {o.id: o.box for o in labels.objects}
-    return {
-        "photo": name,
-        "labels": labels.model_dump(mode="json"),
-        "proposals": [p.to_dict() for p in propose_relations(boxes, rules)],
-    }
+def host_name(header: str) -> str:
+    """The host of a ``Host`` header without its port: ``[::1]:8765`` -> ``::1``."""
+    if header.startswith("["):
+        return header[1 : header.find("]")] if "]" in header else ""
+    return header.rsplit(":", 1)[0] if header.count(":") == 1 else header
+
+
+class _HostGuard:
+    """Answer only requests whose ``Host`` is one of ``allowed`` (DNS-rebinding guard).
+
+    Starlette's TrustedHostMiddleware cuts ``[::1]:port`` at the first colon; this one reads
+    bracketed IPv6 hosts.
+    """
+
+    def __init__(self, app, allowed: tuple[str, ...]) -> None:
+        self.app, self.allowed = app, set(allowed)
+
+    async def __call__(self, scope, receive, send) -> None:
+        if scope["type"] in ("http", "websocket"):
+            headers = dict(scope["headers"])
+            host = host_name(headers.get(b"host", b"").decode("latin-1"))
+            if host not in self.allowed:
+                await Response("Invalid host header", status_code=400)(scope, receive, send)
+                return
+        await self.app(scope, receive, send)
 
 
 async def _read_body(request: Request) -> bytes:
@@ -74,31 +96,48 @@ def create_app(
     photos_dir: Path,
     out_dir: Path,
     *,
-    classes: ClassNames | None = None,
+    class_map: Path | None = None,
+    max_pixels: int = DEFAULT_MAX_PIXELS,
     rules: ProposalRules = DEFAULT_RULES,
     allowed_hosts: tuple[str, ...] | None = LOOPBACK,
 ) -> FastAPI:
     """The labeling app for the photos in ``photos_dir``, saving under ``out_dir/labels``.
 
     Args:
+        class_map: a ``--classes`` TOML file; remembered in ``out_dir/labels`` for later runs
+            and the export (None: the remembered one, if any).
+        max_pixels: larger photos are skipped, with the reason shown in the page.
         allowed_hosts: ``Host`` header values to answer (DNS-rebinding guard); None: any.
 
     Raises:
-        ConfigError: ``photos_dir`` is not a directory, or ``out_dir`` cannot be written.
+        ConfigError: ``photos_dir`` is not a directory, ``out_dir`` cannot be written, or a
+            bad class map.
     """
-    index: PhotoIndex = scan_photos(photos_dir)
     store = LabelStore(out_dir)
-    names = classes or load_class_names()
+    names: ClassNames = load_class_names(store.class_map(class_map))
+    index = [scan_photos(photos_dir, max_pixels=max_pixels)]  # replaced by each rescan
+    scanning = threading.Lock()
 
     app = FastAPI(title="sgdata label", docs_url=None, redoc_url=None, openapi_url=None)
     if allowed_hosts is not None:
-        app.add_middleware(TrustedHostMiddleware, allowed_hosts=list(allowed_hosts))
+        app.add_middleware(_HostGuard, allowed=allowed_hosts)
 
-    def photo_or_404(name: str):
-        photo = index.get(name)
+    def photo_or_404(name: str) -> Photo:
+        photo = index[0].get(name)
         if photo is None:
             raise HTTPException(404, "no such photo")
         return photo
+
+    def payload(name: str, labels: PhotoLabels) -> dict:
+        room = room_instances(store.labeled(), labels.room_id, name)
+        return {
+            "photo": name,
+            "labels": labels.model_dump(mode="json"),
+            "proposals": [p.to_dict() for p in proposals_for(labels, names, rules)],
+            "problems": problems(labels, names, rules, room),
+            # ids the room's other photos use: a new box takes a fresh one
+            "room_ids": sorted(room),
+        }
 
     @app.get("/")
     def page() -> Response:
@@ -110,6 +149,10 @@ def create_app(
             raise HTTPException(404, "no such file")
         return _static(name)
 
+    @app.get("/favicon.ico")
+    def favicon() -> Response:
+        return _static("favicon.svg")
+
     @app.get("/photos/{name}")
     def photo(name: str) -> FileResponse:
         found = photo_or_404(name)
@@ -117,30 +160,39 @@ def create_app(
 
     @app.get("/api/photos")
     def photos() -> JSONResponse:
+        with scanning:  # photos copied in while the server runs appear on the next listing
+            index[0] = scan_photos(photos_dir, max_pixels=max_pixels, previous=index[0])
         saved = store.labeled()
         rows = []
-        for name, p in index.photos.items():
-            labels = saved.get(name)
+        for name, p in index[0].photos.items():
+            labels = saved.get(name, PhotoLabels())
+            todo = problems(labels, names, rules, room_instances(saved, labels.room_id, name))
             rows.append(
                 {
                     "name": name,
                     "width": p.width,
                     "height": p.height,
-                    "room_id": labels.room_id if labels else None,
-                    "objects": len(labels.objects) if labels else 0,
+                    "room_id": labels.room_id,
+                    "objects": len(labels.objects),
+                    "problems": todo,
+                    "ready": not todo,
                 }
             )
-        skipped = [{"name": n, "reason": why} for n, why in index.skipped]
+        skipped = [{"name": n, "reason": why} for n, why in index[0].skipped]
         return JSONResponse({"photos": rows, "skipped": skipped}, headers=_HEADERS)
 
     @app.get("/api/classes")
     def class_names() -> JSONResponse:
         return JSONResponse({"catalog": list(names.catalog), "mapped": names.mapped})
 
+    @app.get("/api/classes/unknown")
+    def unknown_class(name: str) -> JSONResponse:
+        return JSONResponse({"message": names.unknown(name[:100])}, headers=_HEADERS)
+
     @app.get("/api/labels/{name}")
     def get_labels(name: str) -> JSONResponse:
         photo_or_404(name)
-        return JSONResponse(_payload(name, store.load(name), rules), headers=_HEADERS)
+        return JSONResponse(payload(name, store.load(name)), headers=_HEADERS)
 
     @app.put("/api/labels/{name}")
     async def put_labels(name: str, request: Request) -> JSONResponse:
@@ -152,26 +204,28 @@ def create_app(
             raw = json.loads(body)
         except (json.JSONDecodeError, UnicodeDecodeError) as exc:
             raise HTTPException(400, f"malformed JSON ({exc})") from None
+        except RecursionError:
+            raise HTTPException(400, "malformed JSON (nested too deeply)") from None
         try:
             labels = PhotoLabels.model_validate_json(json.dumps(raw))
         except ValidationError as exc:
-            problems = [f"{'.'.join(map(str, e['loc']))}: {e['msg']}" for e in exc.errors()]
-            return JSONResponse({"detail": problems}, status_code=422)
+            errors = [f"{'.'.join(map(str, e['loc']))}: {e['msg']}" for e in exc.errors()]
+            return JSONResponse({"detail": errors}, status_code=422)
         w, h = found.width, found.height
         outside = [o.id for o in labels.objects if o.box[2] > w or o.box[3] > h]
         if outside:
             detail = [f"objects {outside}: box outside the {found.width}x{found.height} photo"]
             return JSONResponse({"detail": detail}, status_code=422)
         unknown = sorted(
-            {o.class_name for o in labels.objects if o.class_name} - {n for n in names.all_names()}
+            {o.class_name for o in labels.objects if o.class_name} - set(names.all_names())
         )
         if unknown:
-            return JSONResponse({"detail": [f"unknown classes {unknown}"]}, status_code=422)
+            return JSONResponse({"detail": [names.unknown(n) for n in unknown]}, status_code=422)
         try:
             stored = store.save(name, labels)
         except ConflictError as exc:
             return JSONResponse({"detail": str(exc), "revision": exc.revision}, status_code=409)
-        return JSONResponse(_payload(name, stored, rules), headers=_HEADERS)
+        return JSONResponse(payload(name, stored), headers=_HEADERS)
 
     return app
 
@@ -183,6 +237,7 @@ def serve(
     host: str = "127.0.0.1",
     port: int = 8765,
     class_map: Path | None = None,
+    max_pixels: int = DEFAULT_MAX_PIXELS,
     on_ready: Callable[[str], None] | None = None,
 ) -> None:
     """Run the labeling app with uvicorn until interrupted (Ctrl-C stops it cleanly).
@@ -194,9 +249,10 @@ def serve(
     """
     import uvicorn
 
-    classes = load_class_names(class_map)
     hosts = LOOPBACK if host in LOOPBACK else None
-    app = create_app(photos_dir, out_dir, classes=classes, allowed_hosts=hosts)
+    app = create_app(
+        photos_dir, out_dir, class_map=class_map, max_pixels=max_pixels, allowed_hosts=hosts
+    )
     config = uvicorn.Config(app, host=host, port=port, log_level="warning", lifespan="on")
     server = uvicorn.Server(config)
     if on_ready is not None:

@@ -18,9 +18,10 @@ from sgdata.errors import DatasetError, SgdataError
 from sgdata.fileio import atomic_write_text, prepare_output_dir, remove_stale_temps
 from sgdata.label.models import PhotoLabels
 
-__all__ = ["LABELS_DIR", "ConflictError", "LabelStore"]
+__all__ = ["CLASS_MAP_COPY", "LABELS_DIR", "ConflictError", "LabelStore"]
 
 LABELS_DIR = "labels"  # under the output directory; not a dataset output (export leaves it)
+CLASS_MAP_COPY = "classes.toml"  # in LABELS_DIR: the last --classes given, used when none is
 
 
 class ConflictError(SgdataError):
@@ -79,6 +80,21 @@ class LabelStore:
             text = json.dumps(stored.model_dump(mode="json"), indent=1, ensure_ascii=False)
             atomic_write_text(self.path(photo), text + "\n")
             return stored
+
+    def class_map(self, given: Path | None) -> Path | None:
+        """The class map to use: ``given`` (remembered for later runs), else the remembered one.
+
+        The labels name mapped classes, so labeling and exporting must use the same map; a copy
+        kept beside the labels means ``--classes`` is given once.
+        """
+        from sgdata.label.classes import load_class_names
+
+        kept = self.dir / CLASS_MAP_COPY
+        if given is None:
+            return kept if kept.is_file() else None
+        load_class_names(given)  # a bad map is an error here, and is not remembered
+        atomic_write_text(kept, Path(given).read_text(encoding="utf-8"))
+        return given
 
     def labeled(self) -> dict[str, PhotoLabels]:
         """Every saved photo's labels, by photo name."""

@@ -249,6 +249,25 @@ def check_objects(tables: SplitTables, raw: dict[str, Any], out: Collector) -> F
         loc("instance"),
         lambda k: f"instance {instance[k]} appears twice in the view",
     )
+    # An instance id is one object of the room: one class in every view of the room.
+    _, room_code = np.unique(column_numpy(obs, "room_id")[p], return_inverse=True)
+    _, first, same = np.unique(
+        room_code.astype(np.int64) * max(n_codes, 1) + codes, return_index=True, return_inverse=True
+    )
+    first_class = class_name[first][same]
+    obs_ids = column_numpy(obs, "obs_id")
+    _report(
+        out,
+        tables,
+        "objects.instance",
+        class_name != first_class,
+        p,
+        loc("class_name"),
+        lambda k: (
+            f"instance {instance[k]} is {class_name[k]!r} here but {first_class[k]!r} in "
+            f"{obs_ids[p[first[same[k]]]]} of the same room; expected one class per instance"
+        ),
+    )
     support = obj.get("support", -1).astype(np.int64)
     _report(
         out,

@@ -3,6 +3,8 @@
 const $ = (s) => document.querySelector(s);
 const SVG = "http://www.w3.org/2000/svg";
 const TYPES = ["on", "in", "proximity", "disjoint"];
+// state.cur.revision is the last revision the server stored; undo snapshots hold labels only,
+// so an undo while a save is in flight cannot bring back an old revision (a false 409).
 const state = { photos: [], idx: -1, names: [], cur: null, selected: null, currentRel: null,
   undo: [], redo: [], saving: null, dirty: false, conflict: false };
 
@@ -20,27 +22,45 @@ async function api(path, options) {
 
 // ------------------------------------------------------------------ loading
 async function init() {
-  const [photos, classes] = await Promise.all([api("/api/photos"), api("/api/classes")]);
-  state.photos = photos.body.photos;
+  const classes = await api("/api/classes");
   state.names = [...classes.body.catalog, ...Object.keys(classes.body.mapped)];
-  for (const s of photos.body.skipped) {
-    const li = document.createElement("li"); li.textContent = `${s.name}: ${s.reason}`; $("#skipped").append(li);
-  }
-  $("#skipped-box").hidden = photos.body.skipped.length === 0;
-  renderList();
+  await refreshList();
   if (state.photos.length) await openPhoto(0); else setStatus("no photos in this directory", true);
+}
+// The server rescans the directory on every listing: photos copied in while labeling appear.
+async function refreshList() {
+  const r = await api("/api/photos");
+  if (!r.ok) return;
+  const name = state.cur && state.cur.name;
+  state.photos = r.body.photos;
+  if (name) state.idx = state.photos.findIndex((p) => p.name === name);
+  const ul = $("#skipped"); ul.textContent = "";
+  for (const s of r.body.skipped) {
+    const li = document.createElement("li"); li.textContent = `${s.name}: ${s.reason}`; ul.append(li);
+  }
+  // Skipped files are problems to see while labeling (a truncated or oversized photo): say how many.
+  const box = $("#skipped-box"), count = r.body.skipped.length;
+  if (count > Number(box.dataset.count || 0)) box.open = true;
+  box.dataset.count = count; box.hidden = count === 0;
+  $("#skipped-box summary").textContent = `${count} skipped file(s)`;
+  renderList();
 }
 function renderList() {
   const ol = $("#photos"); ol.textContent = "";
   state.photos.forEach((p, k) => {
     const li = document.createElement("li");
-    li.dataset.name = p.name; li.className = k === state.idx ? "current" : "";
-    li.innerHTML = `<span></span> <span class="n"></span>`;
-    li.children[0].textContent = p.name;
-    li.children[1].textContent = `${p.room_id || ""} ${p.objects ? "· " + p.objects + " boxes" : ""}`;
+    li.dataset.name = p.name; li.dataset.ready = p.ready ? "yes" : "no";
+    li.className = (k === state.idx ? "current" : "") + (p.ready ? " ready" : "");
+    li.title = p.ready ? "ready to export" : p.problems.join("\n");
+    li.innerHTML = `<span class="mark"></span><span></span> <span class="n"></span>`;
+    li.children[0].textContent = p.ready ? "✓ " : "";
+    li.children[1].textContent = p.name;
+    li.children[2].textContent = `${p.room_id || ""} ${p.objects ? "· " + p.objects + " boxes" : ""}`;
     li.onclick = () => openPhoto(k);
     ol.append(li);
   });
+  const ready = state.photos.filter((p) => p.ready).length;
+  $("#ready-count").textContent = `${ready}/${state.photos.length} ready to export`;
 }
 async function flush() { while (state.saving) await state.saving; }
 async function openPhoto(k) {
@@ -48,9 +68,11 @@ async function openPhoto(k) {
   await flush();
   const p = state.photos[k];
   const r = await api("/api/labels/" + encodeURIComponent(p.name));
+  if (!r.ok) { setStatus(`${p.name}: ${r.body && r.body.detail}`, true); await refreshList(); return; }
   state.idx = k; state.selected = null; state.currentRel = null; state.undo = []; state.redo = [];
   state.conflict = false;
-  state.cur = { name: p.name, width: p.width, height: p.height, labels: r.body.labels, proposals: r.body.proposals };
+  const { revision, ...labels } = r.body.labels;
+  state.cur = { name: p.name, width: p.width, height: p.height, revision, labels, proposals: r.body.proposals, problems: r.body.problems, roomIds: r.body.room_ids };
   const img = $("#photo");
   img.src = "/photos/" + encodeURIComponent(p.name);
   await img.decode().catch(() => {});
@@ -60,6 +82,7 @@ async function openPhoto(k) {
   document.body.dataset.photo = p.name;
   renderList(); renderMeta(); render(); setStatus("loaded");
   $("#stage").focus();
+  refreshList();
 }
 
 // ------------------------------------------------------------------ saving
@@ -72,18 +95,22 @@ function change(mutate) {
 }
 function save() {
   if (state.saving) { state.dirty = true; return; }
-  const name = state.cur.name, labels = state.cur.labels;
-  const body = JSON.stringify(labels);
+  const name = state.cur.name, cur = state.cur;
+  const body = JSON.stringify({ ...cur.labels, revision: cur.revision });
   setStatus("saving");
   state.saving = (async () => {
     try {
       const r = await api("/api/labels/" + encodeURIComponent(name), {
         method: "PUT", headers: { "Content-Type": "application/json" }, body, keepalive: body.length < 60000 });
       if (r.ok) {
-        labels.revision = r.body.labels.revision;
-        if (state.cur.name === name) { state.cur.proposals = r.body.proposals; render(); }
+        cur.revision = r.body.labels.revision;
+        cur.proposals = r.body.proposals; cur.problems = r.body.problems; cur.roomIds = r.body.room_ids;
+        if (state.cur === cur) render();
         const p = state.photos.find((x) => x.name === name);
-        p.room_id = r.body.labels.room_id; p.objects = r.body.labels.objects.length; renderList();
+        if (p) {
+          p.room_id = r.body.labels.room_id; p.objects = r.body.labels.objects.length;
+          p.problems = r.body.problems; p.ready = r.body.problems.length === 0; renderList();
+        }
         setStatus("saved");
       } else if (r.status === 409) {
         state.conflict = true; setStatus(r.body.detail + " (reload the page)", true);
@@ -147,16 +174,17 @@ function el(tag, attrs, parent) {
   if (parent) parent.append(e);
   return e;
 }
+const area = (o) => (o.box[2] - o.box[0]) * (o.box[3] - o.box[1]);
 function scale() { return state.cur.width / ($("#overlay").getBoundingClientRect().width || 1); }
 function render() {
   if (!state.cur) return;
   const s = scale(), L = state.cur.labels, byId = new Map(L.objects.map((o) => [o.id, o]));
   const boxes = $("#boxes"); boxes.textContent = "";
-  for (const o of L.objects) {
+  for (const o of [...L.objects].sort((a, b) => area(b) - area(a))) {
     const [u1, v1, u2, v2] = o.box;
     const g = el("g", { class: "box" + (o.id === state.selected ? " selected" : ""), "data-id": o.id }, boxes);
     el("rect", { class: "body", x: u1, y: v1, width: u2 - u1, height: v2 - v1, "data-id": o.id }, g);
-    const t = el("text", { x: u1 + 3 * s, y: v1 + 16 * s, "font-size": 14 * s }, g);
+    const t = el("text", { x: u1 + 3 * s, y: v1 + 16 * s, "font-size": 14 * s, "stroke-width": 3 * s }, g);
     t.textContent = `${o.id} ${o.class_name || "?"}`;
     if (o.id === state.selected) {
       for (const [cx, cy, corner] of [[u1, v1, "nw"], [u2, v1, "ne"], [u1, v2, "sw"], [u2, v2, "se"]]) {
@@ -176,18 +204,31 @@ function render() {
     const [x2, y2] = [(b.box[0] + b.box[2]) / 2, (b.box[1] + b.box[3]) / 2];
     const g = el("g", { class: `rel ${it.type} ${it.status}${cur ? " current" : ""}`, "data-src": it.src, "data-dst": it.dst, "data-type": it.type, "data-status": it.status }, arrows);
     const both = it.type === "proximity" || it.type === "disjoint";
-    el("line", { class: "hit", x1, y1, x2, y2 }, g);
+    // Only the arrow's label takes clicks: the line ends at box centres, which must select boxes.
     el("line", { class: "shown", x1, y1, x2, y2, "marker-end": "url(#arrow)", ...(both ? { "marker-start": "url(#arrow)" } : {}) }, g);
-    const t = el("text", { x: (x1 + x2) / 2 + 4 * s, y: (y1 + y2) / 2 - 4 * s, "font-size": 13 * s }, g);
+    const t = el("text", { class: "hit", x: (x1 + x2) / 2 + 4 * s, y: (y1 + y2) / 2 - 4 * s, "font-size": 13 * s, "stroke-width": 3 * s }, g);
     t.textContent = it.type + (it.status === "pending" ? "?" : "");
-    g.addEventListener("pointerdown", (e) => { e.stopPropagation(); state.currentRel = key; render(); $("#stage").focus(); });
+    t.addEventListener("pointerdown", (e) => { e.stopPropagation(); state.currentRel = key; render(); $("#stage").focus(); });
     const li = document.createElement("li");
     li.className = it.status + (cur ? " current" : ""); li.dataset.src = it.src; li.dataset.dst = it.dst;
     const arrow = both ? "⟷" : "→";
-    li.textContent = `${it.src} ${a.class_name || "?"} ${arrow}${it.type}${arrow === "→" ? "" : ""} ${it.dst} ${b.class_name || "?"} · ${it.status}`;
+    li.textContent = `${it.src} ${a.class_name || "?"} ${arrow} ${it.type} ${it.dst} ${b.class_name || "?"} · ${it.status}`;
     li.onclick = () => { state.currentRel = key; render(); $("#stage").focus(); };
     list.append(li);
   }
+  const ul = $("#box-list"); ul.textContent = "";
+  for (const o of L.objects) {
+    const li = document.createElement("li");
+    li.dataset.id = o.id; li.className = o.id === state.selected ? "selected" : "";
+    li.textContent = `${o.id} ${o.class_name || "?"} (${o.box[2] - o.box[0]}x${o.box[3] - o.box[1]})`;
+    li.onclick = () => { state.selected = o.id; render(); $("#stage").focus(); };
+    ul.append(li);
+  }
+  const pr = $("#problems"); pr.textContent = "";
+  for (const text of state.cur.problems || []) {
+    const li = document.createElement("li"); li.textContent = text; pr.append(li);
+  }
+  $("#ready").textContent = (state.cur.problems || []).length ? "not ready to export:" : "ready to export";
   const sel = byId.get(state.selected);
   const input = $("#class-input");
   input.disabled = !sel; $("#delete").disabled = !sel;
@@ -216,17 +257,22 @@ $("#overlay").addEventListener("pointerdown", (e) => {
   if (!state.cur || e.button !== 0) return;
   $("#stage").focus();
   const [x, y] = point(e), t = e.target, L = state.cur.labels;
-  const id = t.dataset.id !== undefined ? Number(t.dataset.id) : null;
   const before = clone(L);
-  if (id !== null && t.dataset.corner) drag = { mode: "resize", id, corner: t.dataset.corner, before };
-  else if (id !== null && id === state.selected) {
-    const o = L.objects.find((o) => o.id === id);
-    drag = { mode: "move", id, x, y, box: [...o.box], before };
+  // Boxes under the pointer, smallest first: a click picks the smallest, the next click the
+  // one beneath it, so a box covered by a later, bigger box can still be selected.
+  const under = L.objects.filter((o) => o.box[0] <= x && x <= o.box[2] && o.box[1] <= y && y <= o.box[3])
+    .sort((a, b) => area(a) - area(b)).map((o) => o.id);
+  if (t.dataset.corner) drag = { mode: "resize", id: Number(t.dataset.id), corner: t.dataset.corner, before };
+  else if (state.selected !== null && under.includes(state.selected)) {
+    const o = L.objects.find((o) => o.id === state.selected);
+    const next = under[(under.indexOf(o.id) + 1) % under.length];
+    drag = { mode: "move", id: o.id, x, y, box: [...o.box], before, click: next };
   } else {
     // On empty photo or an unselected box: a drag draws a new box (boxes inside boxes are
     // the usual case), a click without a drag selects the box under the pointer.
-    const next = L.objects.reduce((m, o) => Math.max(m, o.id + 1), 0);
-    drag = { mode: "draw", id: next, x, y, before, added: false, click: id };
+    // A fresh id for the room: ids name objects across the room's photos (carry over keeps them).
+    const next = [...L.objects.map((o) => o.id), ...state.cur.roomIds].reduce((m, id) => Math.max(m, id + 1), 0);
+    drag = { mode: "draw", id: next, x, y, before, added: false, click: under.length ? under[0] : null };
     state.selected = null;
   }
   $("#overlay").setPointerCapture(e.pointerId);
@@ -257,8 +303,10 @@ $("#overlay").addEventListener("pointermove", (e) => {
 $("#overlay").addEventListener("pointerup", () => {
   if (!drag) return;
   const d = drag; drag = null;
-  if (d.mode === "draw" && !d.added && d.click !== null) { state.selected = d.click; render(); return; }
   const changed = JSON.stringify(d.before) !== JSON.stringify(state.cur.labels);
+  if (!changed && ((d.mode === "draw" && !d.added) || d.mode === "move") && d.click != null) {
+    state.selected = d.click; render(); return;
+  }
   if (changed) { state.undo.push(d.before); state.redo = []; render(); save(); }
   if (d.mode === "draw" && d.added) { const input = $("#class-input"); input.disabled = false; input.value = ""; input.focus(); suggest(); }
 });
@@ -288,13 +336,22 @@ function pick(name) {
   change((L) => { L.objects.find((o) => o.id === id).class_name = name; });
   $("#class-input").value = name; $("#stage").focus();
 }
+async function unknownClass(name) {
+  const r = await api("/api/classes/unknown?name=" + encodeURIComponent(name));
+  setStatus(r.ok ? r.body.message : `unknown class ${name}`, true);
+}
 $("#class-input").addEventListener("input", () => { active = 0; suggest(); });
 $("#class-input").addEventListener("blur", () => { $("#class-suggest").textContent = ""; });
 $("#class-input").addEventListener("keydown", (e) => {
   const found = matches(e.target.value);
   if (e.key === "ArrowDown") { active = Math.min(active + 1, found.length - 1); suggest(); e.preventDefault(); }
   else if (e.key === "ArrowUp") { active = Math.max(active - 1, 0); suggest(); e.preventDefault(); }
-  else if (e.key === "Enter") { const exact = state.names.find((n) => n === e.target.value.trim()); pick(found[active] || exact); e.preventDefault(); }
+  else if (e.key === "Enter") {
+    const typed = e.target.value.trim(), exact = state.names.find((n) => n === typed);
+    if (found[active] || exact) pick(found[active] || exact);
+    else if (typed) unknownClass(typed);
+    e.preventDefault();
+  }
   else if (e.key === "Escape") { $("#stage").focus(); }
   e.stopPropagation();
 });
@@ -316,7 +373,11 @@ async function carryOver() {
   for (let k = state.idx - 1; k >= 0; k--) {
     if (state.photos[k].room_id !== room) continue;
     const r = await api("/api/labels/" + encodeURIComponent(state.photos[k].name));
-    const prev = r.body.labels;
+    const prev = r.body.labels, L0 = state.cur.labels;
+    if ((L0.objects.length || L0.relations.length) &&
+        !window.confirm(`Replace the ${L0.objects.length} box(es) of this photo with the ${prev.objects.length} of ${state.photos[k].name}?`)) {
+      setStatus("carry over cancelled"); return;
+    }
     change((L) => { L.room_id = room; L.room_type = prev.room_type; L.objects = prev.objects; L.relations = prev.relations; });
     renderMeta(); setStatus(`carried over ${prev.objects.length} boxes from ${state.photos[k].name}`);
     return;
@@ -340,11 +401,17 @@ function deleteSelected() {
   });
 }
 function undoRedo(from, to) {
-  if (!from.length) return;
+  if (!from.length || state.conflict) return;
   to.push(clone(state.cur.labels));
-  const revision = state.cur.labels.revision;
-  state.cur.labels = { ...from.pop(), revision };
+  state.cur.labels = from.pop();
   renderMeta(); render(); save();
+}
+function cycleBox(step) {
+  const ids = state.cur.labels.objects.map((o) => o.id);
+  if (!ids.length) return;
+  const at = ids.indexOf(state.selected);
+  state.selected = ids[at < 0 ? (step > 0 ? 0 : ids.length - 1) : (at + step + ids.length) % ids.length];
+  render();
 }
 document.addEventListener("keydown", (e) => {
   const tag = (e.target.tagName || "").toLowerCase();
@@ -360,6 +427,7 @@ document.addEventListener("keydown", (e) => {
   else if (e.key === "Tab") nextPending(e.shiftKey ? -1 : 1);
   else if (e.key === "Escape") { state.selected = null; state.currentRel = null; render(); }
   else if (key === "c") carryOver();
+  else if (key === "n") cycleBox(e.shiftKey ? -1 : 1);
   else if (item && e.key === "Enter") { decide(item, item.type === "disjoint" ? "disjoint" : item.type); nextPending(1); }
   else if (item && (key === "o" || key === "i" || key === "p")) { decide(item, { o: "on", i: "in", p: "proximity" }[key]); nextPending(1); }
   else if (item && key === "d") { decide(item, "disjoint"); nextPending(1); }
@@ -369,4 +437,5 @@ document.addEventListener("keydown", (e) => {
   e.preventDefault();
 });
 window.addEventListener("resize", render);
+window.addEventListener("focus", refreshList);
 init();

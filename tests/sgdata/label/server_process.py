@@ -16,23 +16,27 @@ import httpx
 SGDATA = str(Path(sys.executable).parent / "sgdata")
 
 
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
+def free_port(host: str = "127.0.0.1") -> int:
+    family = socket.AF_INET6 if ":" in host else socket.AF_INET
+    with socket.socket(family) as s:
+        s.bind((host, 0))
         return s.getsockname()[1]
 
 
 @contextlib.contextmanager
-def label_server(photos: Path, out: Path, *extra: str) -> Iterator[tuple[str, subprocess.Popen]]:
+def label_server(
+    photos: Path, out: Path, *extra: str, host: str = "127.0.0.1"
+) -> Iterator[tuple[str, subprocess.Popen]]:
     """Yield (base URL, process); the server is stopped (SIGINT, then kill) on exit."""
-    port = free_port()
+    port = free_port(host)
     proc = subprocess.Popen(
-        [SGDATA, "label", str(photos), "--out", str(out), "--port", str(port), *extra],
+        [SGDATA, "label", str(photos), "--out", str(out), "--port", str(port), "--host", host]
+        + list(extra),
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
     )
-    url = f"http://127.0.0.1:{port}"
+    url = f"http://[{host}]:{port}" if ":" in host else f"http://{host}:{port}"
     try:
         deadline = time.monotonic() + 30
         while True:

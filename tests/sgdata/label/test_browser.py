@@ -7,39 +7,16 @@ import subprocess
 from pathlib import Path
 
 import pyarrow.parquet as pq
-import pytest
 
 from sgdata.validate import validate_dataset
 
+from .browser import ARGS, CHROMIUM, needs_chromium
+from .browser import drag as _drag
+from .browser import saved as _saved
 from .conftest import make_photo
 from .server_process import SGDATA, label_server
 
-CHROMIUM = "/usr/bin/chromium"
-ARGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--no-first-run",
-]
-pytestmark = pytest.mark.skipif(not Path(CHROMIUM).exists(), reason="needs Debian's chromium")
-
-
-def _drag(page, box: list[int], photo_size: tuple[int, int]) -> None:
-    """Draw ``box`` (image pixels) with the mouse on the overlay."""
-    r = page.locator("#overlay").bounding_box()
-    sx, sy = r["width"] / photo_size[0], r["height"] / photo_size[1]
-    page.mouse.move(r["x"] + box[0] * sx, r["y"] + box[1] * sy)
-    page.mouse.down()
-    page.mouse.move(r["x"] + (box[0] + box[2]) / 2 * sx, r["y"] + (box[1] + box[3]) / 2 * sy)
-    page.mouse.move(r["x"] + box[2] * sx, r["y"] + box[3] * sy)
-    page.mouse.up()
-
-
-def _saved(page) -> None:
-    page.wait_for_selector('#status[data-state="saved"]')
+pytestmark = needs_chromium
 
 
 def test_label_two_photos_in_the_browser_and_export(tmp_path: Path) -> None:
@@ -76,13 +53,14 @@ def test_label_two_photos_in_the_browser_and_export(tmp_path: Path) -> None:
             rel.wait_for()
             assert rel.get_attribute("data-type") == "on"
             assert rel.get_attribute("data-status") == "pending"
-            rel.locator("line.hit").dispatch_event("pointerdown")
+            rel.locator("text.hit").dispatch_event("pointerdown")
             page.keyboard.press("Enter")  # accept "mug on table"
             page.wait_for_selector('#arrows .rel[data-src="1"][data-status="accepted"]')
             _saved(page)
             if os.environ.get("SGDATA_LABEL_SCREENSHOT"):
                 page.screenshot(path=os.environ["SGDATA_LABEL_SCREENSHOT"])
-            # photo 2: a book inside a shelf, retyped from "in" to "on" with the O key
+            # photo 2: a book inside a shelving unit (not a container: proposed "on"), retyped
+            # to "in" with the I key
             page.keyboard.press("ArrowRight")
             page.wait_for_selector('body[data-photo="p2.png"]')
             page.fill("#room-id", "kitchen_real")
@@ -94,11 +72,13 @@ def test_label_two_photos_in_the_browser_and_export(tmp_path: Path) -> None:
             _drag(page, [100, 120, 140, 160], size)
             page.keyboard.type("Book")
             page.keyboard.press("Enter")
-            page.wait_for_selector('#arrows .rel[data-type="in"][data-status="pending"]')
+            page.wait_for_selector(
+                '#arrows .rel[data-src="3"][data-type="on"][data-status="pending"]'
+            )
             page.locator("#stage").focus()
             page.keyboard.press("Tab")
-            page.keyboard.press("o")
-            page.wait_for_selector('#arrows .rel[data-type="on"][data-status="accepted"]')
+            page.keyboard.press("i")
+            page.wait_for_selector('#arrows .rel[data-type="in"][data-status="accepted"]')
             _saved(page)
             # back to photo 1: its boxes and accepted relation come back from the server
             page.keyboard.press("ArrowLeft")
@@ -128,6 +108,10 @@ def test_label_two_photos_in_the_browser_and_export(tmp_path: Path) -> None:
     for got, want in zip(p1["objects"], ([40, 100, 280, 230], [120, 60, 170, 105]), strict=True):
         assert all(abs(g - w) <= 1 for g, w in zip(got["box2d"], want, strict=True))
     assert [(r["src"], r["dst"], r["type"]) for r in p1["relations"]] == [(1, 0, 0)]
-    assert [o["class_name"] for o in p2["objects"]] == ["ShelvingUnit", "Book"]
-    assert [(r["src"], r["dst"], r["type"]) for r in p2["relations"]] == [(1, 0, 0)]
+    # new boxes of photo 2 take ids the room has not used (0 and 1 are photo 1's table and mug)
+    assert [(o["instance"], o["class_name"]) for o in p2["objects"]] == [
+        (2, "ShelvingUnit"),
+        (3, "Book"),
+    ]
+    assert [(r["src"], r["dst"], r["type"]) for r in p2["relations"]] == [(3, 2, 1)]
     assert p1["domain"] == "real" and p1["image"] == (photos / "p1.png").read_bytes()

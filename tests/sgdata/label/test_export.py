@@ -2,19 +2,24 @@
 
 from __future__ import annotations
 
+import os
+import subprocess
 from pathlib import Path
 
 import pyarrow.parquet as pq
 import pytest
+from fastapi.testclient import TestClient
 
 from sgdata.dataset import Dataset
 from sgdata.errors import ConfigError, DatasetError
 from sgdata.label.export import export_dataset
 from sgdata.label.models import PhotoLabels
+from sgdata.label.server import create_app
 from sgdata.label.store import LabelStore
 from sgdata.validate import validate_dataset
 
 from .conftest import make_photo
+from .server_process import SGDATA
 
 
 def _labels(**fields) -> PhotoLabels:
@@ -32,7 +37,7 @@ def test_export_writes_real_rows_that_validate(photos_dir: Path, tmp_path: Path)
     relations = [{"src": 1, "dst": 0, "type": "on"}]
     store.save("a.png", _labels(objects=objects, relations=relations))
     store.save(
-        "c.jpg", _labels(objects=[{"id": 0, "class_name": "Chair", "box": [10, 10, 150, 90]}])
+        "c.jpg", _labels(objects=[{"id": 4, "class_name": "Chair", "box": [10, 10, 150, 90]}])
     )
     store.save("b.png", PhotoLabels())  # no room id: left out
 
@@ -99,3 +104,59 @@ def test_export_refuses_unknown_classes_and_foreign_datasets(
     store.save("a.png", _labels(revision=1))
     with pytest.raises(ConfigError, match="not a `sgdata label` export"):
         export_dataset(photos_dir, out)
+
+
+def test_validate_wants_one_class_per_instance_in_a_room(photos_dir: Path, tmp_path: Path) -> None:
+    out = tmp_path / "ds"
+    store = LabelStore(out)
+    store.save("a.png", _labels(objects=[{"id": 3, "class_name": "Cup", "box": [1, 1, 9, 9]}]))
+    store.save("b.png", _labels(objects=[{"id": 3, "class_name": "Mug", "box": [1, 1, 9, 9]}]))
+    export_dataset(photos_dir, out)
+    report = validate_dataset(out)
+    (problem,) = report.problems
+    assert problem.check == "objects.instance" and problem.field == "objects[0].class_name"
+    assert "instance 3 is 'Mug' here but 'Cup' in kitchen_real/a" in problem.message
+    # another room may use the id for another class
+    store.save(
+        "b.png",
+        _labels(
+            revision=1, room_id="den", objects=[{"id": 3, "class_name": "Mug", "box": [1, 1, 9, 9]}]
+        ),
+    )
+    export_dataset(photos_dir, out)
+    assert validate_dataset(out).ok
+
+
+def test_undecided_proposals_are_named_by_photo(photos_dir: Path, tmp_path: Path) -> None:
+    out = tmp_path / "ds"
+    store = LabelStore(out)
+    table = {"id": 0, "class_name": "DiningTable", "box": [40, 100, 280, 230]}
+    mug = {"id": 1, "class_name": "Mug", "box": [120, 60, 170, 105]}
+    store.save("a.png", _labels(objects=[table, mug]))
+    store.save("c.jpg", _labels(objects=[{"id": 2, "class_name": "Chair", "box": [1, 1, 9, 9]}]))
+    assert export_dataset(photos_dir, out).pending == {"a.png": 1}
+    done = subprocess.run(
+        [SGDATA, "label", str(photos_dir), "--out", str(out), "--export"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={**os.environ, "COLUMNS": "300"},
+    )
+    assert done.returncode == 0, done.stderr
+    assert "1 undecided proposal(s) stored as disjoint: a.png (1)" in done.stdout
+
+
+def test_a_class_map_given_to_label_is_used_by_export(photos_dir: Path, tmp_path: Path) -> None:
+    out, names = tmp_path / "ds", tmp_path / "names.toml"
+    names.write_text('Saucer = "Plate"\n')
+    client = TestClient(create_app(photos_dir, out, class_map=names), base_url="http://127.0.0.1")
+    body = {"room_id": "k1", "room_type": "kitchen"}
+    body["objects"] = [{"id": 0, "class_name": "Saucer", "box": [1, 1, 9, 9]}]
+    assert client.put("/api/labels/a.png", json=body).status_code == 200
+    names.unlink()  # the export is not given --classes, and the file is gone
+    export_dataset(photos_dir, out)
+    (row,) = pq.read_table(out / "observations/test/k1.parquet").to_pylist()
+    assert row["objects"][0]["class_name"] == "Plate"
+    # and a later `sgdata label` without --classes still offers the name
+    again = TestClient(create_app(photos_dir, out), base_url="http://127.0.0.1")
+    assert again.get("/api/classes").json()["mapped"] == {"Saucer": "Plate"}

@@ -281,3 +281,36 @@ def test_cli_export_then_import(tmp_path: Path) -> None:
         env=env,
     )
     assert bad.returncode == 2 and "expected labelstudio" in bad.stderr
+
+
+ODD_NAMES = ["my cup #1.png", "what?.jpg", "100% tea.png", "tasse à café.jpg", "a b%20c.png"]
+
+
+def test_round_trip_is_byte_exact_for_odd_names(tmp_path: Path) -> None:
+    photos, first = tmp_path / "photos", tmp_path / "ds"
+    photos.mkdir()
+    store = LabelStore(first)
+    for k, name in enumerate(ODD_NAMES):
+        make_photo(photos / name, seed=k)
+        objects = [{"id": 10 + k, "class_name": "Cup", "box": [10 + k, 20, 90, 100]}]
+        labels = {"room_id": "kitchen_real", "room_type": "kitchen", "objects": objects}
+        store.save(name, PhotoLabels.model_validate(labels))
+    export_dataset(photos, first)
+    previous = None
+    source = first
+    for turn in range(2):  # dataset -> Label Studio -> dataset, twice
+        ls = tmp_path / f"ls{turn}.json"
+        export_labelstudio(source, ls, images_dir=tmp_path / f"img{turn}")
+        refs = [t["data"]["image"] for t in json.loads(ls.read_text())]
+        assert "kitchen_real__my%20cup%20%231.png" in refs and "kitchen_real__what%3F.jpg" in refs
+        if previous is not None:
+            assert ls.read_bytes() == previous  # same tasks, same image names, same ids
+        previous = ls.read_bytes()
+        source = tmp_path / f"again{turn}"
+        import_labels("labelstudio", ls, tmp_path / f"img{turn}", source)
+        assert validate_dataset(source).ok
+        assert _content(source) == _content(first)
+        obs = pq.read_table(source / "observations/test/kitchen_real.parquet")["obs_id"]
+        assert sorted(obs.to_pylist()) == sorted(
+            f"kitchen_real/{Path(n).stem}" for n in ODD_NAMES
+        )  # no second room prefix: kitchen_real/kitchen_real__...

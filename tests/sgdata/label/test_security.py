@@ -3,14 +3,18 @@
 from __future__ import annotations
 
 import os
+import socket
 from pathlib import Path
 
+import httpx
 import pytest
 from fastapi.testclient import TestClient
 
 from sgdata.errors import ConfigError
 from sgdata.label.classes import load_class_names
-from sgdata.label.server import MAX_BODY, create_app
+from sgdata.label.server import MAX_BODY, create_app, host_name
+
+from .server_process import label_server
 
 GOOD = {"room_id": "k1", "room_type": "kitchen", "objects": [], "relations": []}
 
@@ -64,6 +68,35 @@ def test_traversal_is_refused(client: TestClient, path: str) -> None:
 
 def test_foreign_host_is_refused(client: TestClient) -> None:
     assert client.get("/api/photos", headers={"Host": "evil.example"}).status_code == 400
+    assert client.get("/api/photos", headers={"Host": "[::2]:8765"}).status_code == 400
+    assert client.get("/api/photos", headers={"Host": "127.0.0.1.evil:80"}).status_code == 400
+
+
+@pytest.mark.parametrize("host", ["[::1]:8765", "[::1]", "127.0.0.1:8765", "localhost"])
+def test_loopback_hosts_are_answered(client: TestClient, host: str) -> None:
+    assert client.get("/api/photos", headers={"Host": host}).status_code == 200
+
+
+def _ipv6_loopback() -> bool:
+    try:
+        with socket.socket(socket.AF_INET6) as s:
+            s.bind(("::1", 0))
+        return True
+    except OSError:
+        return False
+
+
+@pytest.mark.skipif(not _ipv6_loopback(), reason="this machine has no IPv6 loopback")
+def test_a_server_on_ipv6_loopback_answers(photos_dir: Path, tmp_path: Path) -> None:
+    with label_server(photos_dir, tmp_path / "ds", host="::1") as (url, _):
+        assert url.startswith("http://[::1]:")
+        assert httpx.get(url + "/api/photos").status_code == 200
+        assert httpx.get(url + "/api/photos", headers={"Host": "evil.example"}).status_code == 400
+
+
+def test_host_name_reads_bracketed_ipv6() -> None:
+    assert host_name("[::1]:8765") == "::1" and host_name("127.0.0.1:80") == "127.0.0.1"
+    assert host_name("[::1") == "" and host_name("localhost") == "localhost"
 
 
 @pytest.mark.parametrize(
@@ -78,6 +111,8 @@ def test_foreign_host_is_refused(client: TestClient) -> None:
         (b'{"relations": [{"src": 0, "dst": 1, "type": "on"}]}', 422),
         (b"[]", 422),
         (b"{" + b" " * (MAX_BODY + 1) + b"}", 413),
+        (b"[" * 200_000 + b"]" * 200_000, 400),  # nested too deep for the parser: not a 500
+        (b'{"objects": [{"id": 0, "class_name": "Saucer", "box": [1, 1, 5, 5]}]}', 422),
     ],
 )
 def test_bad_saves_are_refused_and_change_nothing(
@@ -89,6 +124,20 @@ def test_bad_saves_are_refused_and_change_nothing(
     response = client.put("/api/labels/a.png", content=body, headers=headers)
     assert response.status_code == status
     assert _labels_dir(tmp_path) == before
+
+
+def test_unknown_class_names_the_closest_and_how_to_map(client: TestClient) -> None:
+    body = {**GOOD, "objects": [{"id": 0, "class_name": "Saucr", "box": [1, 1, 5, 5]}]}
+    (detail,) = client.put("/api/labels/a.png", json=body).json()["detail"]
+    assert detail.startswith("unknown class 'Saucr'; closest: ") and "--classes" in detail
+    message = client.get("/api/classes/unknown", params={"name": "Mugg"}).json()["message"]
+    assert "closest: Mug" in message and '"Mugg" = "Mug"' in message
+
+
+def test_favicon_is_served(client: TestClient) -> None:
+    for path in ("/favicon.ico", "/static/favicon.svg"):
+        response = client.get(path)
+        assert response.status_code == 200 and response.content.startswith(b"<svg")
 
 
 def test_other_content_types_and_unknown_photos_are_refused(client: TestClient) -> None:

@@ -1,0 +1,53 @@
+"""Proposal accuracy: the scoring on hand-made pairs, and the doc's table is the script's."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+from sgdata.label.accuracy import score_proposals
+from sgdata.label.classes import load_class_names
+from sgdata.label.models import PhotoLabels
+from sgdata.label.proposals import DEFAULT_RULES
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+def _labels(relations: list[dict]) -> PhotoLabels:
+    objects = [
+        {"id": 0, "class_name": "DiningTable", "box": [40, 100, 280, 230]},
+        {"id": 1, "class_name": "Mug", "box": [120, 60, 170, 105]},
+        {"id": 2, "class_name": "Chair", "box": [600, 600, 700, 700]},
+    ]
+    return PhotoLabels.model_validate({"objects": objects, "relations": relations})
+
+
+def test_pairs_agree_on_type_and_direction() -> None:
+    names = load_class_names()
+    right = score_proposals(
+        {"a": _labels([{"src": 1, "dst": 0, "type": "on"}])}, names, DEFAULT_RULES
+    )
+    assert (right.pairs, right.agree, right.hits["on"], right.hits["disjoint"]) == (3, 3, 1, 2)
+    wrong = score_proposals(
+        {"a": _labels([{"src": 0, "dst": 1, "type": "on"}])}, names, DEFAULT_RULES
+    )
+    assert (wrong.agree, wrong.labeled["on"], wrong.proposed["on"], wrong.hits["on"]) == (
+        2,
+        1,
+        1,
+        0,
+    )
+    undecided = score_proposals({"a": _labels([])}, names, DEFAULT_RULES)
+    assert undecided.labeled["disjoint"] == 3 and undecided.agree == 2
+
+
+def test_the_doc_prints_the_measured_table() -> None:
+    spec = importlib.util.spec_from_file_location(
+        "label_proposals", ROOT / "bench/label_proposals.py"
+    )
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    doc = (ROOT / "docs/labeling.md").read_text(encoding="utf-8")
+    assert f"{script.BEGIN}\n{script.table()}\n{script.END}" in doc, (
+        "docs/labeling.md is stale: run python bench/label_proposals.py --write"
+    )
