@@ -235,7 +235,12 @@ def _train(config: TrainConfig, data: Path, run: Path, pretrained: Path | None) 
 
 
 def calibrate_batches(config: TrainConfig, data: Path, budget_s: float) -> int:
-    """Batches per epoch that fill ``budget_s`` seconds of training, from timed steps."""
+    """Batches per epoch that fill ``budget_s`` seconds of training, from timed steps.
+
+    A step is timed in CPU seconds of this process divided by torch's threads (on the GPU:
+    wall seconds): on a machine shared with other work the wall clock counts their time too,
+    and the budget would then depend on what else ran during the calibration.
+    """
     torch.manual_seed(0)
     device = device_for_run()
     model = build_for_dataset(config, data).to(device)
@@ -248,18 +253,20 @@ def calibrate_batches(config: TrainConfig, data: Path, budget_s: float) -> int:
     )
     loader = DataLoader(triplets, batch_size=config.batch_size, collate_fn=collate_triplets)
     batches = itertools.islice(loader, _CALIBRATION_STEPS + 1)
+    gpu = device.type == "cuda"
+    clock = time.perf_counter if gpu else time.process_time
     marks: list[float] = []
 
-    def clock(_phase: str, _step: int, _total: int, _metrics: dict[str, float]) -> None:
-        if device.type == "cuda":
+    def mark(_phase: str, _step: int, _total: int, _metrics: dict[str, float]) -> None:
+        if gpu:
             torch.cuda.synchronize()  # kernels run asynchronously: time them, not their launch
-        marks.append(time.perf_counter())
+        marks.append(clock())
 
-    start = time.perf_counter()
-    train_one_epoch(model, batches, triplet_step(model, loss_fn, device), optimizer, progress=clock)
+    start = clock()
+    train_one_epoch(model, batches, triplet_step(model, loss_fn, device), optimizer, progress=mark)
     # the first step pays for allocation; each later one from the mark before it (the
     # loader's read of the next batch counts: a run pays for it too)
-    seconds = np.diff([start, *marks])[1:]
+    seconds = np.diff([start, *marks])[1:] / (1 if gpu else torch.get_num_threads())
     per_epoch = budget_s / config.epochs
     return max(1, int(per_epoch / float(np.median(seconds))))
 
