@@ -36,13 +36,19 @@ from sgdata.dataset import (
     observation_table,
     observations_path,
     parse_obs_id,
+    read_table,
     schema,
     triplet_table,
     triplets_path,
     write_manifest,
     write_parquet,
 )
-from sgdata.dataset.schema import FORMAT_VERSION, observations_schema, triplets_schema
+from sgdata.dataset.schema import (
+    FORMAT_VERSION,
+    file_schema,
+    observations_schema,
+    triplets_schema,
+)
 from sgdata.errors import DatasetError
 from sgdata.pipeline.config import GenerateConfig, config_to_dict
 from sgdata.world.triplets import PoseKey, Triplet
@@ -264,14 +270,22 @@ def test_plain_tools_read_the_files(tmp_path: Path) -> None:
     write_parquet(triplet_table(make_triplets("kitchen_000", "train")), tri)
     n_objects = sum(len(o) for o in table.column("objects").to_pylist())
 
-    back = pq.read_table(obs)
-    assert back.equals(table) and back.schema.equals(table.schema, check_metadata=True)
+    back = pq.read_table(obs)  # on disk: the image as the Hugging Face {bytes, path} struct
+    stored = file_schema(observations_schema())
+    assert back.schema.equals(stored, check_metadata=True)
+    assert back.drop_columns("image").equals(table.drop_columns("image"))
+    assert back.column("image").to_pylist() == [
+        {"bytes": b, "path": None} for b in table.column("image").to_pylist()
+    ]
+    assert read_table(obs, observations_schema()).equals(table)  # in memory: the bytes
 
     frame = pl.read_parquet(obs)
     assert frame.height == 8
     assert frame.select(pl.col("objects").list.len().sum()).item() == n_objects
     exploded = frame.select("obs_id", "objects").explode("objects").unnest("objects")
     assert exploded.drop_nulls("instance").height == n_objects
+    png = frame.select(pl.col("image").struct.field("bytes")).to_series().to_list()
+    assert png == table.column("image").to_pylist()
 
     con = duckdb.connect()
     count = con.execute(f"SELECT count(*) FROM read_parquet('{obs}'), unnest(objects)").fetchone()
@@ -284,7 +298,7 @@ def test_plain_tools_read_the_files(tmp_path: Path) -> None:
     tiers = con.execute(f"SELECT tier, count(*) FROM '{tri}' GROUP BY tier ORDER BY tier")
     assert tiers.fetchall() == [(0, 1), (4, 1)]
     box = con.execute(
-        f"SELECT camera.width, octet_length(image) > 0 FROM '{obs}' LIMIT 1"
+        f"SELECT camera.width, octet_length(image.bytes) > 0 FROM '{obs}' LIMIT 1"
     ).fetchone()
     assert box == (W, True)
 
@@ -363,22 +377,23 @@ def test_manifest_cross_field_problems_at_once() -> None:
 
 def test_compat_newer_major_refused_with_upgrade_hint() -> None:
     with pytest.raises(FormatVersionError) as info:
-        check_compatible("2.0.0")
+        check_compatible("3.0.0")
     assert str(info.value) == (
-        "dataset.json format_version 2.0.0 is newer than this sgdata reads (1.x); "
+        "dataset.json format_version 3.0.0 is newer than this sgdata reads (2.x); "
         "upgrade sgdata: pip install -U sgdata"
     )
     assert isinstance(info.value, DatasetError)
     data = json.loads(make_manifest().to_json())
-    data["format_version"] = "2.0.0"
+    data["format_version"] = "3.0.0"
     with pytest.raises(FormatVersionError, match="pip install -U sgdata"):
         Manifest.from_json(json.dumps(data))
     for bad in ("1.0", "one", "1.0.0.0", ""):
         with pytest.raises(FormatVersionError, match="expected a semantic version"):
             check_compatible(bad)
-    with pytest.raises(FormatVersionError, match="older"):
+    with pytest.raises(FormatVersionError, match=r"older than this sgdata reads \(1.x to 2.x\)"):
         check_compatible("0.9.0")
-    check_compatible("1.7.3")  # same major: fine
+    check_compatible("2.7.3")  # same major: fine
+    check_compatible("1.1.0")  # 1.x: read through sgdata.dataset.storage
 
 
 def _fake_migration(raw: dict) -> dict:
@@ -404,10 +419,10 @@ def test_older_minor_is_migrated_through_the_hook(monkeypatch: pytest.MonkeyPatc
 
 def test_newer_minor_drops_unknown_keys() -> None:
     data = json.loads(make_manifest().to_json())
-    data["format_version"] = "1.4.0"
+    data["format_version"] = "2.4.0"
     data["future_field"] = {"x": 1}
     parsed = Manifest.from_json(json.dumps(data))
-    assert parsed.format_version == "1.4.0"
+    assert parsed.format_version == "2.4.0"
 
 
 # --------------------------------------------------------------------------- reader
