@@ -44,6 +44,7 @@ __all__ = [
 
 FORMAT_NAME = "sgdata"
 META_FILES = (CARD, CROISSANT)  # written by write_manifest from the manifest itself
+META_SINCE = "2.0.0"  # the format version that added META_FILES
 NUM_TIERS = 5
 
 

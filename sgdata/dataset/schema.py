@@ -180,13 +180,15 @@ def schema_at(schema: pa.Schema, version: str) -> pa.Schema:
 def file_schema(schema: pa.Schema, version: str = FORMAT_VERSION) -> pa.Schema:
     """``schema`` (in memory) as a Parquet file of format ``version`` holds it: without the
     columns added later and, from 2.0.0, image columns as Hugging Face ``Image`` storage with
-    the ``huggingface`` schema metadata.
+    the ``huggingface`` schema metadata (as :func:`sgdata.dataset.storage.file_table` writes).
 
     Raises:
         FormatVersionError: ``version`` is not a semantic version.
     """
     at = schema_at(schema, version)
-    if _parse_version(version) < _parse_version(IMAGE_STORAGE_SINCE):
+    if _parse_version(version) < _parse_version(IMAGE_STORAGE_SINCE) or not any(
+        is_image_field(f) for f in at
+    ):
         return at
     fields = [stored_image_field(f) if is_image_field(f) else f for f in at]
     metadata = {**(at.metadata or {}), HF_METADATA_KEY: hf_schema_metadata(at)}

@@ -68,8 +68,11 @@ def hf_schema_metadata(schema: pa.Schema) -> bytes:
 
 def file_table(table: pa.Table) -> pa.Table:
     """``table`` as the current format writes it: image columns as :data:`IMAGE_STORAGE`
-    (path null) and the ``huggingface`` metadata; a table without image columns as is."""
-    names = image_field_names(table.schema)
+    (path null) and the ``huggingface`` metadata; a table without image columns as is, and
+    one already in that form (read back with pyarrow) too."""
+    names = [
+        n for n in image_field_names(table.schema) if pa.types.is_binary(table.schema.field(n).type)
+    ]
     if not names:
         return table
     fields, columns = [], []

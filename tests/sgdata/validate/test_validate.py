@@ -2,16 +2,18 @@
 
 from __future__ import annotations
 
+import hashlib
 import json
 import shutil
 from collections.abc import Callable
 from pathlib import Path
 
 import pyarrow as pa
+import pyarrow.compute as pc
 import pyarrow.parquet as pq
 import pytest
 
-from sgdata.dataset import write_parquet
+from sgdata.dataset import read_manifest, write_manifest, write_parquet
 from sgdata.errors import DatasetError
 from sgdata.validate import ValidationReport, validate_dataset
 
@@ -41,7 +43,8 @@ def edit_manifest(root: Path, change: Callable[[dict], None]) -> None:
 
 
 def rewrite(root: Path, rel: str, table: pa.Table, *, update_manifest: bool = True) -> None:
-    """Write ``table`` over ``rel``; with ``update_manifest``, fix its rows/sha256/bytes."""
+    """Write ``table`` over ``rel``; with ``update_manifest``, fix its rows/sha256/bytes (and
+    write the card and croissant.json again, as a writer would)."""
     info = write_parquet(table, root / rel)
 
     def fix(raw: dict) -> None:
@@ -51,6 +54,32 @@ def rewrite(root: Path, rel: str, table: pa.Table, *, update_manifest: bool = Tr
 
     if update_manifest:
         edit_manifest(root, fix)
+        write_manifest(read_manifest(root), root)
+
+
+def legacy_dataset(root: Path, *, drop: tuple[str, ...] | list[str] = ()) -> None:
+    """Turn a generated dataset into a format 1.1.0 one, as sgdata 1.x wrote it: images as bare
+    bytes (non-null binary, no huggingface metadata), no card, no croissant.json."""
+    raw = json.loads((root / "dataset.json").read_text())
+    files = []
+    for entry in raw["files"]:
+        path = root / entry["path"]
+        if entry["path"] in ("README.md", "croissant.json"):
+            path.unlink()
+            continue
+        if entry["path"].startswith("observations/"):
+            table = pq.read_table(path).drop_columns(list(drop))
+            at = table.schema.get_field_index("image")
+            doc = {b"doc": table.schema.field("image").metadata[b"doc"]}
+            field = pa.field("image", pa.binary(), nullable=False, metadata=doc)
+            table = table.set_column(at, field, pc.struct_field(table.column("image"), "bytes"))
+            metadata = {k: v for k, v in table.schema.metadata.items() if k != b"huggingface"}
+            pq.write_table(table.replace_schema_metadata(metadata), path)
+            digest = hashlib.sha256(path.read_bytes()).hexdigest()
+            entry.update(sha256=digest, bytes=path.stat().st_size)
+        files.append(entry)
+    raw.update(files=files, format_version="1.1.0")
+    (root / "dataset.json").write_text(json.dumps(raw, indent=2))
 
 
 def rows_of(root: Path, rel: str) -> tuple[list[dict], pa.Schema]:
@@ -237,10 +266,11 @@ def test_room_in_two_splits(copy: Path) -> None:
 
 def test_corrupt_image(copy: Path) -> None:
     table = pq.read_table(copy / SHARD)
-    images = table.column("image").to_pylist()
-    images[2] = b"\x89PNG garbage" + bytes(200)
+    images = table.column("image").to_pylist()  # {bytes, path} on disk
+    images[2] = {"bytes": b"\x89PNG garbage" + bytes(200), "path": None}
     at = table.schema.get_field_index("image")
-    table = table.set_column(at, table.schema.field("image"), pa.array(images, pa.binary()))
+    field = table.schema.field("image")
+    table = table.set_column(at, field, pa.array(images, field.type))
     rewrite(copy, SHARD, table)
     report = validate_dataset(copy)
     assert checks(report) == {"images.decode"}
@@ -258,7 +288,7 @@ def test_manifest_schema_and_version(copy: Path) -> None:
     edit_manifest(copy, lambda raw: raw.update(num_slots="many", format_version="1.0.0"))
     report = validate_dataset(copy, quick=True)
     assert find(report, "manifest.schema")[0].field == "num_slots"
-    edit_manifest(copy, lambda raw: raw.update(format_version="2.0.0"))
+    edit_manifest(copy, lambda raw: raw.update(format_version="3.0.0"))
     report = validate_dataset(copy, quick=True)
     assert "newer" in find(report, "manifest.version")[0].message
 
@@ -315,10 +345,7 @@ def test_a_format_1_0_dataset_without_appearance_columns_still_reads(copy: Path)
     from sgdata.dataset import Dataset
 
     added = ["textures", "light_intensity", "light_temperature"]
-    raw = json.loads((copy / "dataset.json").read_text())
-    for entry in raw["files"]:
-        if entry["path"].startswith("observations/"):
-            rewrite(copy, entry["path"], pq.read_table(copy / entry["path"]).drop_columns(added))
+    legacy_dataset(copy, drop=added)
 
     def as_1_0(raw: dict) -> None:
         raw["format_version"] = "1.0.0"
