@@ -278,6 +278,12 @@ def test_plain_tools_read_the_files(tmp_path: Path) -> None:
         {"bytes": b, "path": None} for b in table.column("image").to_pylist()
     ]
     assert read_table(obs, observations_schema()).equals(table)  # in memory: the bytes
+    cell = back.column("image")[0].as_py()  # a consumer on plain pyarrow: the dict decodes too
+    np.testing.assert_array_equal(
+        decode_image(cell), decode_image(table.column("image")[0].as_py())
+    )
+    with pytest.raises(DatasetError, match="expected encoded bytes or a dict with 'bytes'"):
+        decode_image({"path": "x.png"})
 
     frame = pl.read_parquet(obs)
     assert frame.height == 8

@@ -360,3 +360,46 @@ def test_a_format_1_0_dataset_without_appearance_columns_still_reads(copy: Path)
     edit_manifest(copy, lambda raw: raw.update(format_version="1.1.0"))
     report = validate_dataset(copy, quick=True)
     assert {p.field for p in find(report, "tables.schema")} == set(added)
+
+
+def test_a_format_1_1_dataset_reads_validates_and_migrates(copy: Path, mini_dataset: Path) -> None:
+    from sgdata.dataset import FORMAT_VERSION, Dataset, migrate_dataset
+
+    legacy_dataset(copy)
+    assert pq.read_schema(copy / SHARD).field("image").type == pa.binary()
+    report = validate_dataset(copy)  # images decoded too
+    assert report.ok, report.problems[:3]
+    assert {"metadata.card", "metadata.croissant"} <= set(report.skipped)
+    old, new = Dataset.open(copy), Dataset.open(mini_dataset)
+    assert old.manifest.format_version == "1.1.0"  # read as it is, not renamed
+    columns = ["obs_id", "image"]
+    assert old.observations("train", columns=columns).equals(
+        new.observations("train", columns=columns)
+    )
+
+    manifest = migrate_dataset(copy)
+    assert manifest.format_version == FORMAT_VERSION
+    report = validate_dataset(copy)
+    assert report.ok and not {"metadata.card", "metadata.croissant"} & set(report.skipped)
+    generated = {f.path: f.sha256 for f in new.manifest.files}
+    migrated = {f.path: f.sha256 for f in manifest.files}
+    assert migrated == generated  # the very bytes generate writes: tables, card, croissant
+    assert (copy / "dataset.json").read_bytes() == (mini_dataset / "dataset.json").read_bytes()
+
+
+def test_card_and_croissant_that_disagree_are_reported(copy: Path) -> None:
+    card = copy / "README.md"
+    text = card.read_text()
+    card.write_text(text.replace("num_examples: ", "num_examples: 1", 1))
+    crate = json.loads((copy / "croissant.json").read_text())
+    crate["distribution"][0]["sha256"] = "0" * 64
+    (copy / "croissant.json").write_text(json.dumps(crate))
+    report = validate_dataset(copy, quick=True)
+    assert checks(report) == {"metadata.card", "metadata.croissant", "files.sha256", "files.bytes"}
+    (problem,) = find(report, "metadata.card")
+    assert "num_examples: 1" in problem.message and problem.field.startswith("front matter line")
+    (problem,) = find(report, "metadata.croissant")
+    first = crate["distribution"][0]["@id"]
+    assert problem.field == f"distribution[{first}].sha256"
+    card.unlink()
+    assert "missing" in find(validate_dataset(copy, quick=True), "metadata.card")[0].message
