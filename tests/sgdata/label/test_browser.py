@@ -130,4 +130,4 @@ def test_label_two_photos_in_the_browser_and_export(tmp_path: Path) -> None:
     assert [(r["src"], r["dst"], r["type"]) for r in p1["relations"]] == [(1, 0, 0)]
     assert [o["class_name"] for o in p2["objects"]] == ["ShelvingUnit", "Book"]
     assert [(r["src"], r["dst"], r["type"]) for r in p2["relations"]] == [(1, 0, 0)]
-    assert p1["domain"] == "real" and p1["image"] == (photos / "p1.png").read_bytes()
+    assert p1["domain"] == "real" and p1["image"]["bytes"] == (photos / "p1.png").read_bytes()
