@@ -5,6 +5,8 @@ from __future__ import annotations
 import hashlib
 import json
 import shutil
+import subprocess
+import sys
 from collections.abc import Callable
 from pathlib import Path
 
@@ -377,7 +379,10 @@ def test_a_format_1_1_dataset_reads_validates_and_migrates(copy: Path, mini_data
         new.observations("train", columns=columns)
     )
 
-    manifest = migrate_dataset(copy)
+    cli = [sys.executable, "-m", "sgdata_cli.sgdata_app", "migrate"]  # the command, end to end
+    done = subprocess.run([*cli, str(copy)], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    manifest = read_manifest(copy)
     assert manifest.format_version == FORMAT_VERSION
     report = validate_dataset(copy)
     assert report.ok and not {"metadata.card", "metadata.croissant"} & set(report.skipped)
@@ -385,6 +390,10 @@ def test_a_format_1_1_dataset_reads_validates_and_migrates(copy: Path, mini_data
     migrated = {f.path: f.sha256 for f in manifest.files}
     assert migrated == generated  # the very bytes generate writes: tables, card, croissant
     assert (copy / "dataset.json").read_bytes() == (mini_dataset / "dataset.json").read_bytes()
+    assert migrate_dataset(copy) == manifest  # a current dataset: nothing changes
+    done = subprocess.run([*cli, str(copy / "scenes")], capture_output=True, text=True)
+    assert done.returncode != 0 and "no dataset.json" in done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1
 
 
 def test_card_and_croissant_that_disagree_are_reported(copy: Path) -> None:
