@@ -412,3 +412,20 @@ def test_card_and_croissant_that_disagree_are_reported(copy: Path) -> None:
     assert problem.field == f"distribution[{first}].sha256"
     card.unlink()
     assert "missing" in find(validate_dataset(copy, quick=True), "metadata.card")[0].message
+
+
+def test_a_shard_without_the_huggingface_metadata_is_reported(copy: Path) -> None:
+    table = pq.read_table(copy / SHARD)
+    metadata = {k: v for k, v in table.schema.metadata.items() if k != b"huggingface"}
+    pq.write_table(table.replace_schema_metadata(metadata), copy / SHARD)
+    raw = json.loads((copy / "dataset.json").read_text())
+    for entry in raw["files"]:
+        if entry["path"] == SHARD:
+            data = (copy / SHARD).read_bytes()
+            entry.update(sha256=hashlib.sha256(data).hexdigest(), bytes=len(data))
+    (copy / "dataset.json").write_text(json.dumps(raw, indent=2))
+    write_manifest(read_manifest(copy), copy)  # card and croissant.json follow the new sha256
+    report = validate_dataset(copy, quick=True)
+    (problem,) = find(report, "tables.schema")
+    assert problem.file == SHARD and "'huggingface'" in problem.message
+    assert checks(report) == {"tables.schema"}
