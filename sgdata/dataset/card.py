@@ -12,7 +12,7 @@ from __future__ import annotations
 import json
 import re
 from collections import Counter
-from pathlib import Path
+from pathlib import Path, PurePosixPath
 from typing import TYPE_CHECKING, Any
 
 import pyarrow as pa
@@ -38,16 +38,25 @@ __all__ = [
     "write_card",
 ]
 
-# The licence the card and croissant.json declare for generated data: the scenes are procedural
-# and the catalog is the project's own (MIT code), so the data carries the usual open-data
-# licence. A dataset of photos (label --export) inherits it too; its owner may change the card.
+# The licence the card and croissant.json declare: the scenes are procedural and the catalog
+# is the project's own, so generated data carries the usual open-data licence. Every dataset
+# declares it, photos from `label --export` too (validate checks the card against the
+# manifest, so a per-dataset licence needs a manifest key first).
 DATA_LICENSE = "cc-by-4.0"
 DATA_LICENSE_URL = "https://creativecommons.org/licenses/by/4.0/"
 PAPER_URL = "https://arxiv.org/abs/2110.02276"
 CONFIGS = ("observations", "triplets")  # the card's configs, observations the default
 TASKS = ("image-feature-extraction", "object-detection")
 TAGS = ("scene-graph", "indoor", "localization", "synthetic", "sgdata", "croissant")
-_SIZES = ((1_000, "n<1K"), (10_000, "1K<n<10K"), (100_000, "10K<n<100K"), (1_000_000, "100K<n<1M"))
+# The Hugging Face Hub's size_categories tags, by number of views.
+_SIZES = (
+    (1_000, "n<1K"),
+    (10_000, "1K<n<10K"),
+    (100_000, "10K<n<100K"),
+    (1_000_000, "100K<n<1M"),
+    (10_000_000, "1M<n<10M"),
+    (100_000_000, "10M<n<100M"),
+)
 _PLAIN_KEY = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 _FENCE = "---"
 
@@ -95,6 +104,11 @@ def hf_features(schema: pa.Schema, labels: dict[str, dict[str, list[str]]]) -> l
 # --------------------------------------------------------------------------- front matter
 
 
+def _folder(template: str, split: str) -> str:
+    """The folder (with its trailing ``/``) of a split's files under ``template``."""
+    return str(PurePosixPath(template.format(split=split)).parent) + "/"
+
+
 def _split_bytes(manifest: Manifest, prefix: str) -> int:
     return sum(f.bytes for f in manifest.files if f.path.startswith(prefix))
 
@@ -111,7 +125,7 @@ def card_metadata(manifest: Manifest) -> dict[str, Any]:
         "relations": {"type": list(manifest.relation_types)},
     }
     total = sum(manifest.counts.observations.values())
-    size = next((label for bound, label in _SIZES if total < bound), "n>1M")
+    size = next((label for bound, label in _SIZES if total < bound), "100M<n<1B")
     return {
         "license": DATA_LICENSE,
         "pretty_name": manifest.name,
@@ -136,9 +150,7 @@ def card_metadata(manifest: Manifest) -> dict[str, Any]:
                 "splits": [
                     {
                         "name": s,
-                        "num_bytes": _split_bytes(
-                            manifest, obs_glob.format(split=s)[: -len("*.parquet")]
-                        ),
+                        "num_bytes": _split_bytes(manifest, _folder(obs_glob, s)),
                         "num_examples": manifest.counts.observations[s],
                     }
                     for s in obs_splits
