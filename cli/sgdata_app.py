@@ -311,6 +311,18 @@ def validate(
 
 
 @app.command()
+def migrate(
+    root: Annotated[Path, typer.Argument(help="Dataset root (holding dataset.json).")],
+) -> None:
+    """Rewrite a format 1.x dataset in the current format, in place (card and croissant.json
+    included)."""
+    from sgdata.dataset import migrate_dataset
+
+    manifest = migrate_dataset(root)
+    console.print(f"{root}: format {manifest.format_version}, {len(manifest.files)} files")
+
+
+@app.command()
 def report(
     root: Annotated[Path, typer.Argument(help="Dataset root (holding dataset.json).")],
     output: Annotated[Path, typer.Option("-o", "--output", help="Directory to write into.")] = Path(

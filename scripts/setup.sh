@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Sets up a fresh machine: Debian packages for headless EGL rendering and open3d (when root),
-# then a Python 3.11 virtual environment in .venv with sgdata installed in editable mode.
-# Idempotent: a second run only re-installs when pyproject.toml changed.
+# then a virtual environment in .venv with sgdata installed in editable mode, on Python 3.11,
+# 3.12 or 3.13: whichever `python3` is, or PYTHON=python3.12 (a name or a path).
+# Idempotent: a second run only re-installs when pyproject.toml or this script changed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -22,18 +23,33 @@ if [ "${#missing[@]}" -gt 0 ]; then
   fi
 fi
 
-python=$(command -v python3.11 || command -v python3)
-if ! "$python" -c 'import sys; sys.exit(sys.version_info[:2] != (3, 11))'; then
-  echo "setup: Python 3.11 is required (torch 2.14.1 wheels are cp311); found $("$python" --version)" >&2
+# torch 2.14.1, torchvision, open3d 0.20 and usd-core 26.11 publish cp311, cp312 and cp313 wheels.
+minor() { "$1" -c 'import sys; print("%d.%d" % sys.version_info[:2])' 2>/dev/null || echo none; }
+python=$(command -v "${PYTHON:-python3}" || echo "${PYTHON:-python3}")
+version=$(minor "$python")
+case "$version" in
+  3.11 | 3.12 | 3.13) ;;
+  *)
+    echo "setup: Python 3.11, 3.12 or 3.13 is required; ${PYTHON:-python3} is ${version/none/not a runnable Python} (set PYTHON=python3.12, for example)" >&2
+    exit 1
+    ;;
+esac
+if [ -x .venv/bin/python ] && [ "$(minor .venv/bin/python)" != "$version" ]; then
+  echo "setup: .venv is Python $(minor .venv/bin/python), not $version; remove it (rm -rf .venv) to switch" >&2
   exit 1
 fi
 [ -x .venv/bin/python ] || "$python" -m venv .venv
 
 stamp=.venv/.sgdata-installed
-want=$(sha256sum pyproject.toml | cut -d' ' -f1)
+want=$(cat pyproject.toml scripts/setup.sh | sha256sum | cut -d' ' -f1)
 if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
-  echo "setup: installing Python dependencies into .venv (torch is large: a few minutes)"
-  .venv/bin/pip install -q --upgrade pip >/dev/null
-  .venv/bin/pip install -q -e '.[dev]'
+  echo "setup: installing Python dependencies into .venv on Python $version (torch is large: a few minutes)"
+  .venv/bin/python -m pip install -q --upgrade pip >/dev/null
+  .venv/bin/python -m pip install -q -e '.[dev]'
+  # pyrender 0.1.45 pins PyOpenGL 3.1.0, whose ctypes array handlers break glGenTextures on
+  # Python 3.12+ (textured rendering fails); 3.1.10 works on 3.11-3.13 and renders the same
+  # bytes (checked with llvmpipe EGL). Installed over the pin on every Python, so all match
+  # (`pip check` names the pin; --no-deps installs without complaint).
+  .venv/bin/python -m pip install -q --no-deps 'PyOpenGL==3.1.10'
   echo "$want" > "$stamp"
 fi

@@ -9,6 +9,9 @@ lazily: ``import sgdata`` loads no USD, renderer or torch, and changes no enviro
 from sgdata.lazy_face import lazy_face
 
 __version__ = "0.1.0"  # the one home of the version (pyproject.toml reads it)
+# The release date of __version__: a dataset's croissant.json states it as datePublished (the
+# data is a pure function of config, seed and generator, and its files carry no timestamps).
+__release_date__ = "2026-12-01"
 
 _EXPORTS = {
     "CatalogError": ".errors",

@@ -21,6 +21,9 @@ _EXPORTS = {
     "read_manifest": ".manifest",
     "relation_type_names": ".manifest",
     "write_manifest": ".manifest",
+    "migrate_dataset": ".migrate",
+    "CARD": ".paths",
+    "CROISSANT": ".paths",
     "MANIFEST": ".paths",
     "OBSERVATIONS": ".paths",
     "OUTPUTS": ".paths",
@@ -49,6 +52,8 @@ _EXPORTS = {
     "triplet_table": ".rows",
     "write_parquet": ".rows",
     "FORMAT_VERSION": ".schema",
+    "OLDEST_READABLE": ".schema",
+    "file_schema": ".schema",
     "FormatVersionError": ".schema",
     "MIGRATIONS": ".schema",
     "SCHEMA_PACKAGE": ".schema",
@@ -63,6 +68,8 @@ _EXPORTS = {
     "table_schema": ".schema",
     "triplets_schema": ".schema",
     "class_vocabulary": ".vocabulary",
+    "IMAGE_STORAGE": ".storage",
+    "image_bytes": ".storage",
 }
 
 __all__ = sorted(_EXPORTS)

@@ -12,14 +12,16 @@ from __future__ import annotations
 
 import json
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import jsonschema
 
 from sgdata.annotate.relations import RelationType
-from sgdata.dataset.paths import MANIFEST, SPLITS
+from sgdata.dataset.card import write_card
+from sgdata.dataset.croissant import write_croissant
+from sgdata.dataset.paths import CARD, CROISSANT, MANIFEST, SPLITS
 from sgdata.dataset.rows import sha256_file
 from sgdata.dataset.schema import FORMAT_VERSION, manifest_json_schema, migrate_manifest_dict
 from sgdata.errors import DatasetError
@@ -41,6 +43,8 @@ __all__ = [
 ]
 
 FORMAT_NAME = "sgdata"
+META_FILES = (CARD, CROISSANT)  # written by write_manifest from the manifest itself
+META_SINCE = "2.0.0"  # the format version that added META_FILES
 NUM_TIERS = 5
 
 
@@ -351,7 +355,16 @@ def read_manifest(root: Path) -> Manifest:
 
 
 def write_manifest(manifest: Manifest, root: Path) -> Path:
-    """Write ``root/dataset.json`` atomically (the last file generation writes)."""
-    path = Path(root) / MANIFEST
-    atomic_write_text(path, manifest.to_json())
+    """The last step of every writer (generate, label export and import): the dataset card
+    ``README.md`` and ``croissant.json`` from ``manifest``, then ``root/dataset.json`` listing
+    them too; each written atomically, the manifest last (no manifest = unfinished)."""
+    root = Path(root)
+    data = replace(manifest, files=tuple(f for f in manifest.files if f.path not in META_FILES))
+    write_card(root, data)
+    write_croissant(root, data)
+    files = (*data.files, *(file_entry(root, name) for name in META_FILES))
+    path = root / MANIFEST
+    atomic_write_text(
+        path, replace(data, files=tuple(sorted(files, key=lambda f: f.path))).to_json()
+    )
     return path

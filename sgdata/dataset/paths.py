@@ -4,6 +4,8 @@ All paths are relative to the dataset root and use ``/`` on every platform (they
 ``files[].path`` entries of ``dataset.json``)::
 
     dataset.json                              the manifest
+    README.md                                 the dataset card (Hugging Face front matter)
+    croissant.json                            MLCommons Croissant metadata
     scenes/<room_id>/room.usda                the base room
     scenes/<room_id>/layout_<k>.usda          layout k as a USD layer over the base
     scenes/<room_id>/source.usda              a user's room ([rooms] files), flattened
@@ -22,6 +24,8 @@ from sgdata.scene_files import LAYOUT_FILE, ROOM_FILE, TEXTURES_DIR
 
 __all__ = [
     "MANIFEST",
+    "CARD",
+    "CROISSANT",
     "OBSERVATIONS",
     "TRIPLETS",
     "SCENES",
@@ -40,6 +44,8 @@ __all__ = [
 ]
 
 MANIFEST = "dataset.json"
+CARD = "README.md"
+CROISSANT = "croissant.json"
 OBSERVATIONS = "observations/{split}/{room_id}.parquet"
 TRIPLETS = "triplets/{split}.parquet"
 SCENES = "scenes/{room_id}"
@@ -48,7 +54,7 @@ SCENE_LAYER = SCENES + "/" + LAYOUT_FILE.replace("{index}", "{layout}")
 SCENE_TEXTURES = SCENES.split("/")[0] + "/" + TEXTURES_DIR  # beside the room directories
 SPLITS = ("train", "val", "test")  # the split names a dataset may hold, in this order
 # What a generation writes at the top of a dataset directory (``--force`` removes exactly these).
-OUTPUTS = (MANIFEST, *(t.split("/")[0] for t in (SCENES, OBSERVATIONS, TRIPLETS)))
+OUTPUTS = (MANIFEST, CARD, CROISSANT, *(t.split("/")[0] for t in (SCENES, OBSERVATIONS, TRIPLETS)))
 
 _FORBIDDEN_IN_ROOM_ID = ("/", "\\", "..")
 

@@ -7,7 +7,7 @@ need no sgdata code at all (see docs/dataset.md for pyarrow, polars, DuckDB and 
 from __future__ import annotations
 
 import io
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -19,17 +19,20 @@ from sgdata.dataset.manifest import Manifest, read_manifest
 from sgdata.dataset.paths import MANIFEST, observations_path, triplets_path
 from sgdata.dataset.rows import sha256_file
 from sgdata.dataset.schema import FORMAT_VERSION, observations_schema, since, triplets_schema
+from sgdata.dataset.storage import image_bytes, is_image_field, memory_column
 from sgdata.errors import DatasetError
 
 __all__ = ["Dataset", "decode_image", "read_table"]
 
 
-def decode_image(data: bytes) -> np.ndarray:
-    """An ``(H, W, 3)`` uint8 array from encoded PNG or JPEG bytes (an ``image`` cell).
+def decode_image(data: bytes | Mapping[str, object]) -> np.ndarray:
+    """An ``(H, W, 3)`` uint8 array from an ``image`` cell: encoded PNG or JPEG bytes, or the
+    ``{"bytes", "path"}`` dict a format 2.x file gives plain pyarrow.
 
     Raises:
-        DatasetError: the bytes are not a readable image.
+        DatasetError: the cell is not a readable image.
     """
+    data = image_bytes(data)
     try:
         with Image.open(io.BytesIO(data)) as image:
             return np.asarray(image.convert("RGB"))
@@ -47,7 +50,8 @@ def read_table(
     The one reader of observation and triplet files: :class:`Dataset`, ``sgdata validate`` and
     the training loader all come through here. Columns the file has beyond the schema (a newer
     minor format) are not read; columns a later minor added (``since`` in the schema) that an
-    older file lacks come back as nulls.
+    older file lacks come back as nulls. Image columns come back as encoded bytes whether the
+    file stores them as the ``{bytes, path}`` struct (2.x) or as bytes (1.x).
 
     Args:
         cast: cast columns whose type differs but converts (``validate`` reports the type
@@ -75,6 +79,12 @@ def read_table(
                 f"{path}: no column(s) {missing}; not a format {FORMAT_VERSION} {name} table"
             )
         table = pq.read_table(path, columns=[n for n in names if n not in added])
+        for n in names:
+            if n not in added and is_image_field(schema.field(n)):
+                at = table.schema.get_field_index(n)
+                table = table.set_column(
+                    at, expected.field(n), memory_column(table.column(at), f"{path}: column {n}")
+                )
         if added:  # an older minor's file: the columns added since are null
             table = pa.Table.from_arrays(
                 [

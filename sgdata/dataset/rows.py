@@ -25,6 +25,7 @@ from PIL import Image
 from sgdata.annotate.records import ViewRecord
 from sgdata.dataset.paths import SCENE_LAYER, obs_id
 from sgdata.dataset.schema import observations_schema, triplets_schema
+from sgdata.dataset.storage import file_table
 from sgdata.errors import DatasetError
 from sgdata.world.triplets import Triplet
 
@@ -309,6 +310,9 @@ def sha256_file(path: Path) -> tuple[str, int]:
 def write_parquet(table: pa.Table, path: Path) -> ParquetInfo:
     """Write ``table`` to ``path`` atomically with :data:`PARQUET_OPTIONS`.
 
+    Image columns (bytes in memory) are stored as the Hugging Face ``Image`` struct, with the
+    ``huggingface`` schema metadata (:func:`sgdata.dataset.storage.file_table`).
+
     The file is written to a temporary name in the same directory and renamed over ``path``
     only once complete, so a reader never sees half a file and a failure leaves none.
 
@@ -325,7 +329,7 @@ def write_parquet(table: pa.Table, path: Path) -> ParquetInfo:
     tmp = Path(tmp_name)
     try:
         with os.fdopen(fd, "wb") as handle:
-            pq.write_table(table, handle, **PARQUET_OPTIONS)
+            pq.write_table(file_table(table), handle, **PARQUET_OPTIONS)
             handle.flush()
             os.fsync(handle.fileno())
         digest, size = sha256_file(tmp)

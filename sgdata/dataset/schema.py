@@ -14,10 +14,12 @@ The DSL: a table is ``{"name", "format_version", "doc", "fields": [field, ...]}`
 ``{"name", "type", "nullable", "doc"}``, plus ``"since": "<version>"`` on a nullable column a
 minor version added (Arrow metadata ``b"since"``: readers fill it with nulls in files of an
 older minor, and :func:`schema_at` drops it from what such a file must hold); a type is one
-of ``string binary bool int8 int16 int32 int64 float32 float64``, ``{"list": T}``,
-``{"fixed_list": [T, n]}`` or ``{"struct": [field, ...]}``. Field docs become Arrow field
-metadata under ``b"doc"``. List elements are non-null and named ``element`` (the
-Parquet-compliant name, so a schema read back from a file compares equal to the one written).
+of ``string binary bool int8 int16 int32 int64 float32 float64``, ``image`` (encoded bytes in
+memory, Hugging Face ``Image`` storage on disk: :mod:`sgdata.dataset.storage`, and
+:func:`file_schema`), ``{"list": T}``, ``{"fixed_list": [T, n]}`` or ``{"struct": [field, ...]}``.
+Field docs become Arrow field metadata under ``b"doc"``. List elements are non-null and named
+``element`` (the Parquet-compliant name, so a schema read back from a file compares equal to
+the one written).
 """
 
 from __future__ import annotations
@@ -32,27 +34,42 @@ from typing import Any
 
 import pyarrow as pa
 
+from sgdata.dataset.storage import (
+    HF_METADATA_KEY,
+    IMAGE_STORAGE_SINCE,
+    STORAGE_KEY,
+    hf_schema_metadata,
+    is_image_field,
+    stored_image_field,
+)
 from sgdata.errors import DatasetError
 
 __all__ = [
     "FORMAT_VERSION",
     "MIGRATIONS",
     "SCHEMA_PACKAGE",
+    "OLDEST_READABLE",
     "FormatVersionError",
     "check_compatible",
+    "file_schema",
     "migrate_manifest_dict",
     "observations_schema",
     "triplets_schema",
     "manifest_json_schema",
     "table_schema",
     "parse_table_schema",
+    "primitive_name",
     "schema_at",
     "schema_markdown",
     "since",
 ]
 
-FORMAT_VERSION = "1.1.0"  # semver of the whole on-disk format: tables + dataset.json
-# 1.1.0 added the observation columns textures, light_intensity and light_temperature.
+FORMAT_VERSION = "2.0.0"  # semver of the whole on-disk format: tables + dataset.json
+# 1.1.0 added the observation columns textures, light_intensity and light_temperature; 2.0.0
+# stores `image` as the Hugging Face Image struct and adds README.md and croissant.json.
+# The oldest format this sgdata reads: 1.x differs from 2.x only in how images are stored
+# (sgdata.dataset.storage reads both) and in lacking the card and Croissant files.
+OLDEST_READABLE = "1.0.0"
 SCHEMA_PACKAGE = "sgdata_schemas"  # the installed name of the repository's `schemas/` folder
 LIST_ELEMENT = "element"  # Parquet's compliant list element name (pyarrow writes it by default)
 UPGRADE_HINT = "upgrade sgdata: pip install -U sgdata"
@@ -74,6 +91,7 @@ _PRIMITIVES: dict[str, pa.DataType] = {
     "float32": pa.float32(),
     "float64": pa.float64(),
 }
+_IMAGE = "image"  # the DSL's image type: binary in memory, IMAGE_STORAGE on disk
 _FIELD_KEYS = {"name", "type", "nullable", "doc"}
 _OPTIONAL_KEYS = {"since"}
 
@@ -91,9 +109,11 @@ def _read_json(filename: str) -> dict[str, Any]:
 
 def _parse_type(spec: Any, where: str) -> pa.DataType:
     if isinstance(spec, str):
+        if spec == _IMAGE:
+            return pa.binary()
         if spec not in _PRIMITIVES:
             raise DatasetError(
-                f"{where}: unknown type {spec!r}; expected one of {list(_PRIMITIVES)}"
+                f"{where}: unknown type {spec!r}; expected one of {[*_PRIMITIVES, _IMAGE]}"
             )
         return _PRIMITIVES[spec]
     if isinstance(spec, dict) and len(spec) == 1:
@@ -125,6 +145,8 @@ def _parse_field(spec: Any, parent: str) -> pa.Field:
     if not isinstance(spec["nullable"], bool):
         raise DatasetError(f"{where}: nullable {spec['nullable']!r}; expected true or false")
     metadata = {b"doc": str(spec["doc"]).encode("utf-8")}
+    if spec["type"] == _IMAGE:
+        metadata[STORAGE_KEY] = _IMAGE.encode()
     if "since" in spec:
         added = spec["since"]
         if not spec["nullable"] or _parse_version(added) > _parse_version(FORMAT_VERSION):
@@ -153,6 +175,24 @@ def schema_at(schema: pa.Schema, version: str) -> pa.Schema:
     at = _parse_version(version)
     keep = [f for f in schema if since(f) is None or _parse_version(since(f)) <= at]
     return pa.schema(keep, metadata=schema.metadata)
+
+
+def file_schema(schema: pa.Schema, version: str = FORMAT_VERSION) -> pa.Schema:
+    """``schema`` (in memory) as a Parquet file of format ``version`` holds it: without the
+    columns added later and, from 2.0.0, image columns as Hugging Face ``Image`` storage with
+    the ``huggingface`` schema metadata (as :func:`sgdata.dataset.storage.file_table` writes).
+
+    Raises:
+        FormatVersionError: ``version`` is not a semantic version.
+    """
+    at = schema_at(schema, version)
+    if _parse_version(version) < _parse_version(IMAGE_STORAGE_SINCE) or not any(
+        is_image_field(f) for f in at
+    ):
+        return at
+    fields = [stored_image_field(f) if is_image_field(f) else f for f in at]
+    metadata = {**(at.metadata or {}), HF_METADATA_KEY: hf_schema_metadata(at)}
+    return pa.schema(fields, metadata=metadata)
 
 
 def parse_table_schema(spec: dict[str, Any]) -> pa.Schema:
@@ -231,23 +271,25 @@ def _parse_version(version: object) -> tuple[int, int, int]:
 def check_compatible(manifest_version: str, *, current: str | None = None) -> None:
     """Whether this sgdata reads a dataset of format ``manifest_version``; raises if not.
 
-    ``current`` defaults to :data:`~sgdata.schema.FORMAT_VERSION`.
+    ``current`` defaults to :data:`~sgdata.schema.FORMAT_VERSION`; the majors from
+    :data:`OLDEST_READABLE`'s up to ``current``'s are read.
 
     Raises:
-        FormatVersionError: malformed version, or another major version than ``current``.
+        FormatVersionError: malformed version, or a major outside that range.
     """
     major = _parse_version(manifest_version)[0]
     ours = _parse_version(current or FORMAT_VERSION)[0]
+    oldest = min(_parse_version(OLDEST_READABLE)[0], ours)
     if major > ours:
         raise FormatVersionError(
             f"dataset.json format_version {manifest_version} is newer than this sgdata reads "
             f"({ours}.x); {UPGRADE_HINT}"
         )
-    if major < ours:
+    if major < oldest:
         raise FormatVersionError(
             f"dataset.json format_version {manifest_version} is older than this sgdata reads "
-            f"({ours}.x); read it with an older sgdata (pip install 'sgdata<{ours}') or "
-            "regenerate it: sgdata generate"
+            f"({oldest}.x to {ours}.x); read it with an older sgdata "
+            f"(pip install 'sgdata<{oldest}') or regenerate it: sgdata generate"
         )
 
 
@@ -297,14 +339,22 @@ def migrate_manifest_dict(
 # --------------------------------------------------------------------------- docs
 
 
-def _type_text(t: pa.DataType) -> str:
+def _type_text(t: pa.DataType, field: pa.Field | None = None) -> str:
     if pa.types.is_fixed_size_list(t):
         return f"{_type_text(t.value_type)}[{t.list_size}]"
     if pa.types.is_list(t):
         return f"list<{_type_text(t.value_type)}>"
     if pa.types.is_struct(t):
         return "struct"
-    return next(name for name, p in _PRIMITIVES.items() if p == t)  # the DSL's own names
+    if pa.types.is_binary(t) and field is not None and is_image_field(field):
+        return _IMAGE
+    return primitive_name(t)
+
+
+def primitive_name(t: pa.DataType) -> str:
+    """The DSL name of a primitive Arrow type (``int16``, ``float64`` ...; also the dtype
+    names of Hugging Face ``datasets``)."""
+    return next(name for name, p in _PRIMITIVES.items() if p == t)
 
 
 def _rows(fields: list[pa.Field], prefix: str) -> list[str]:
@@ -315,7 +365,7 @@ def _rows(fields: list[pa.Field], prefix: str) -> list[str]:
             doc = f"{doc} (since format {since(f)})"
         doc = doc.replace("|", "\\|").replace("<", "\\<")  # Markdown table cell
         null = "yes" if f.nullable else "no"
-        lines.append(f"| `{prefix}{f.name}` | `{_type_text(f.type)}` | {null} | {doc} |")
+        lines.append(f"| `{prefix}{f.name}` | `{_type_text(f.type, f)}` | {null} | {doc} |")
         inner = f.type
         while pa.types.is_list(inner) or pa.types.is_fixed_size_list(inner):
             inner = inner.value_type

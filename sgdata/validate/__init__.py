@@ -1,8 +1,9 @@
 """``sgdata validate``: check a dataset on disk against its format and collect every problem.
 
 One entry point, :func:`validate_dataset`, runs the check families in order (see
-docs/validate.md): manifest, files, tables, rows/objects/relations, relation recompute,
-triplets, images, scenes, and with ``sources`` the user room files. Nothing stops at the
+docs/validate.md): manifest, files, metadata (card and Croissant), tables,
+rows/objects/relations, relation recompute, triplets, images, scenes, and with ``sources`` the
+user room files. Nothing stops at the
 first failure: the report lists every :class:`Problem` with its file, row and field.
 """
 
@@ -26,6 +27,7 @@ from sgdata.validate.manifest_checks import (
     check_splits,
     read_raw_manifest,
 )
+from sgdata.validate.metadata_checks import check_metadata
 from sgdata.validate.problems import Collector, Problem, ValidationReport
 from sgdata.validate.relation_checks import check_recompute
 from sgdata.validate.scene_checks import check_scenes
@@ -81,6 +83,7 @@ def validate_dataset(
 def _check_contents(root: Path, raw: dict, out: Collector, *, quick: bool, usd: bool) -> None:
     check_splits(raw, out)
     check_files(root, raw, out)
+    check_metadata(root, raw, out)
     newer = _parse_version(raw["format_version"])[:2] > _parse_version(FORMAT_VERSION)[:2]
     splits = []
     for split in raw["splits"]:

@@ -11,6 +11,8 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 from PIL import Image
 
+from sgdata.dataset.storage import memory_column
+from sgdata.errors import DatasetError
 from sgdata.validate.problems import Collector
 
 __all__ = ["check_images", "inspect_image"]
@@ -49,7 +51,10 @@ def check_images(root: Path, files: list[str], out: Collector, *, workers: int =
             camera = table.column("camera").combine_chunks()
             width = camera.field("width").to_numpy(zero_copy_only=False).astype(np.int64)
             height = camera.field("height").to_numpy(zero_copy_only=False).astype(np.int64)
-            images = table.column("image").to_pylist()
+            try:  # the {bytes, path} struct (2.x) or bytes (1.x)
+                images = memory_column(table.column("image"), f"{rel}: column image").to_pylist()
+            except DatasetError:
+                continue  # the wrong type is reported by the table checks
             formats = table.column("image_format").to_pylist()
             jobs = zip(images, formats, width.tolist(), height.tolist(), strict=True)
             results = pool.map(lambda job: inspect_image(*job), jobs)

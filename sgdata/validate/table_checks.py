@@ -12,7 +12,8 @@ import pyarrow.compute as pc
 import pyarrow.parquet as pq
 
 from sgdata.dataset.paths import observations_path, triplets_path
-from sgdata.dataset.schema import FORMAT_VERSION, observations_schema, schema_at, triplets_schema
+from sgdata.dataset.schema import FORMAT_VERSION, file_schema, observations_schema, triplets_schema
+from sgdata.dataset.storage import HF_METADATA_KEY
 from sgdata.validate.loading import SplitTables, column_numpy, read_table_as
 from sgdata.validate.problems import Collector
 
@@ -87,7 +88,7 @@ def _compare_fields(
 
 def compare_schema(
     found: pa.Schema, wanted: pa.Schema, *, extra_ok: bool = False
-) -> list[tuple[str, str]]:
+) -> list[tuple[str | None, str]]:
     """Differences between a file's schema and the format's: ``(field path, message)`` each.
 
     ``extra_ok``: columns beyond the format's are allowed (a newer minor format adds them).
@@ -103,6 +104,15 @@ def _schema_check(root: Path, rel: str, wanted: pa.Schema, out: Collector, extra
         out.add("tables.schema", rel, f"not a readable Parquet file ({exc})")
         return False
     diffs = compare_schema(found, wanted, extra_ok=extra_ok)
+    hf = (wanted.metadata or {}).get(HF_METADATA_KEY)
+    if hf is not None and (found.metadata or {}).get(HF_METADATA_KEY) != hf:
+        diffs.append(
+            (
+                None,
+                "schema metadata 'huggingface' missing or not the image features; datasets "
+                f"will not decode the images (expected {hf.decode()})",
+            )
+        )
     for where, message in diffs:
         out.add("tables.schema", rel, message, field=where)
     return not diffs
@@ -113,11 +123,12 @@ def load_split(
 ) -> SplitTables:
     """Schema-check and read one split's shards (no images) and triplet table.
 
-    Files must hold the columns of the dataset's own format version (``schema_at``); columns a
-    later minor added are read as nulls from an older dataset."""
+    Files must hold the columns of the dataset's own format version, stored as that version
+    stores them (``file_schema``); columns a later minor added are read as nulls from an older
+    dataset."""
     obs_schema = observations_schema()
     version = str(raw.get("format_version", FORMAT_VERSION))
-    obs_wanted = schema_at(obs_schema, version)
+    obs_wanted = file_schema(obs_schema, version)
     tables, files, file_index, file_row = [], [], [], []
     for room in raw["splits"][split]:
         rel = observations_path(split, room)
@@ -138,7 +149,7 @@ def load_split(
     trel = triplets_path(split)
     triplets = None
     if (root / trel).is_file():
-        _schema_check(root, trel, schema_at(triplets_schema(), version), out, extra_ok)
+        _schema_check(root, trel, file_schema(triplets_schema(), version), out, extra_ok)
         triplets = read_table_as(root / trel, triplets_schema())
         if triplets is None:
             out.add(

@@ -36,13 +36,19 @@ from sgdata.dataset import (
     observation_table,
     observations_path,
     parse_obs_id,
+    read_table,
     schema,
     triplet_table,
     triplets_path,
     write_manifest,
     write_parquet,
 )
-from sgdata.dataset.schema import FORMAT_VERSION, observations_schema, triplets_schema
+from sgdata.dataset.schema import (
+    FORMAT_VERSION,
+    file_schema,
+    observations_schema,
+    triplets_schema,
+)
 from sgdata.errors import DatasetError
 from sgdata.pipeline.config import GenerateConfig, config_to_dict
 from sgdata.world.triplets import PoseKey, Triplet
@@ -264,14 +270,28 @@ def test_plain_tools_read_the_files(tmp_path: Path) -> None:
     write_parquet(triplet_table(make_triplets("kitchen_000", "train")), tri)
     n_objects = sum(len(o) for o in table.column("objects").to_pylist())
 
-    back = pq.read_table(obs)
-    assert back.equals(table) and back.schema.equals(table.schema, check_metadata=True)
+    back = pq.read_table(obs)  # on disk: the image as the Hugging Face {bytes, path} struct
+    stored = file_schema(observations_schema())
+    assert back.schema.equals(stored, check_metadata=True)
+    assert back.drop_columns("image").equals(table.drop_columns("image"))
+    assert back.column("image").to_pylist() == [
+        {"bytes": b, "path": None} for b in table.column("image").to_pylist()
+    ]
+    assert read_table(obs, observations_schema()).equals(table)  # in memory: the bytes
+    cell = back.column("image")[0].as_py()  # a consumer on plain pyarrow: the dict decodes too
+    np.testing.assert_array_equal(
+        decode_image(cell), decode_image(table.column("image")[0].as_py())
+    )
+    with pytest.raises(DatasetError, match="expected encoded bytes or a dict with 'bytes'"):
+        decode_image({"path": "x.png"})
 
     frame = pl.read_parquet(obs)
     assert frame.height == 8
     assert frame.select(pl.col("objects").list.len().sum()).item() == n_objects
     exploded = frame.select("obs_id", "objects").explode("objects").unnest("objects")
     assert exploded.drop_nulls("instance").height == n_objects
+    png = frame.select(pl.col("image").struct.field("bytes")).to_series().to_list()
+    assert png == table.column("image").to_pylist()
 
     con = duckdb.connect()
     count = con.execute(f"SELECT count(*) FROM read_parquet('{obs}'), unnest(objects)").fetchone()
@@ -284,7 +304,7 @@ def test_plain_tools_read_the_files(tmp_path: Path) -> None:
     tiers = con.execute(f"SELECT tier, count(*) FROM '{tri}' GROUP BY tier ORDER BY tier")
     assert tiers.fetchall() == [(0, 1), (4, 1)]
     box = con.execute(
-        f"SELECT camera.width, octet_length(image) > 0 FROM '{obs}' LIMIT 1"
+        f"SELECT camera.width, octet_length(image.bytes) > 0 FROM '{obs}' LIMIT 1"
     ).fetchone()
     assert box == (W, True)
 
@@ -363,22 +383,23 @@ def test_manifest_cross_field_problems_at_once() -> None:
 
 def test_compat_newer_major_refused_with_upgrade_hint() -> None:
     with pytest.raises(FormatVersionError) as info:
-        check_compatible("2.0.0")
+        check_compatible("3.0.0")
     assert str(info.value) == (
-        "dataset.json format_version 2.0.0 is newer than this sgdata reads (1.x); "
+        "dataset.json format_version 3.0.0 is newer than this sgdata reads (2.x); "
         "upgrade sgdata: pip install -U sgdata"
     )
     assert isinstance(info.value, DatasetError)
     data = json.loads(make_manifest().to_json())
-    data["format_version"] = "2.0.0"
+    data["format_version"] = "3.0.0"
     with pytest.raises(FormatVersionError, match="pip install -U sgdata"):
         Manifest.from_json(json.dumps(data))
     for bad in ("1.0", "one", "1.0.0.0", ""):
         with pytest.raises(FormatVersionError, match="expected a semantic version"):
             check_compatible(bad)
-    with pytest.raises(FormatVersionError, match="older"):
+    with pytest.raises(FormatVersionError, match=r"older than this sgdata reads \(1.x to 2.x\)"):
         check_compatible("0.9.0")
-    check_compatible("1.7.3")  # same major: fine
+    check_compatible("2.7.3")  # same major: fine
+    check_compatible("1.1.0")  # 1.x: read through sgdata.dataset.storage
 
 
 def _fake_migration(raw: dict) -> dict:
@@ -404,10 +425,10 @@ def test_older_minor_is_migrated_through_the_hook(monkeypatch: pytest.MonkeyPatc
 
 def test_newer_minor_drops_unknown_keys() -> None:
     data = json.loads(make_manifest().to_json())
-    data["format_version"] = "1.4.0"
+    data["format_version"] = "2.4.0"
     data["future_field"] = {"x": 1}
     parsed = Manifest.from_json(json.dumps(data))
-    assert parsed.format_version == "1.4.0"
+    assert parsed.format_version == "2.4.0"
 
 
 # --------------------------------------------------------------------------- reader
@@ -510,15 +531,18 @@ def test_reader_ignores_columns_of_a_newer_minor(tiny_dataset: Path) -> None:
 
 
 def test_docs_examples_run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """The pyarrow, polars, sgdata and DuckDB examples of docs/dataset.md run on a tiny dataset
-    at out/tiny (the Hugging Face one needs `datasets`, which is not a dependency)."""
+    """Every example of docs/dataset.md runs on a tiny dataset at out/tiny: sgdata, pyarrow,
+    polars, DuckDB, and (with the dev extra) Hugging Face `datasets` and `mlcroissant`."""
     build_tiny_dataset(tmp_path / "out" / "tiny")
     monkeypatch.chdir(tmp_path)
+    datasets = pytest.importorskip("datasets")
+    pytest.importorskip("mlcroissant")
+    monkeypatch.setattr(datasets.config, "HF_DATASETS_CACHE", tmp_path / "hf")
     text = (Path(__file__).resolve().parents[3] / "docs" / "dataset.md").read_text()
     blocks = re.findall(r"```(python|sql)\n(.*?)```", text, re.S)
     ran = 0
     for lang, code in blocks:
-        if lang == "python" and "from datasets import" not in code:
+        if lang == "python":
             exec(compile(code, "docs/dataset.md", "exec"), {})
             ran += 1
         elif lang == "sql":
@@ -526,4 +550,4 @@ def test_docs_examples_run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> N
             for statement in filter(str.strip, code.split(";")):
                 assert con.execute(statement).fetchall()
                 ran += 1
-    assert ran >= 7
+    assert ran >= 10

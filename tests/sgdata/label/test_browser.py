@@ -114,4 +114,4 @@ def test_label_two_photos_in_the_browser_and_export(tmp_path: Path) -> None:
         (3, "Book"),
     ]
     assert [(r["src"], r["dst"], r["type"]) for r in p2["relations"]] == [(3, 2, 1)]
-    assert p1["domain"] == "real" and p1["image"] == (photos / "p1.png").read_bytes()
+    assert p1["domain"] == "real" and p1["image"]["bytes"] == (photos / "p1.png").read_bytes()

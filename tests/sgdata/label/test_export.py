@@ -52,7 +52,7 @@ def test_export_writes_real_rows_that_validate(photos_dir: Path, tmp_path: Path)
     assert set(rows) == {"kitchen_real/a", "kitchen_real/c"}
     a = rows["kitchen_real/a"]
     assert a["domain"] == "real" and a["image_format"] == "png"
-    assert a["image"] == (photos_dir / "a.png").read_bytes()  # the photo's own bytes
+    assert a["image"]["bytes"] == (photos_dir / "a.png").read_bytes()  # the photo's own bytes
     assert a["grid_i"] is None and a["camera"]["width"] == 320
     assert [o["class_name"] for o in a["objects"]] == ["DiningTable", "Mug", "Apple"]
     assert all(o["box3d_min"] is None and o["obb"] is None for o in a["objects"])

@@ -198,7 +198,7 @@ def _content(root: Path) -> dict:
     for shard in sorted((root / "observations/test").glob("*.parquet")):
         for r in pq.read_table(shard).to_pylist():
             key = (
-                r["image"],
+                r["image"]["bytes"],  # format 2.x: the Hugging Face Image struct
                 r["room_id"],
                 r["room_type"],
                 r["layout"],

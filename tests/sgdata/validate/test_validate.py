@@ -2,16 +2,20 @@
 
 from __future__ import annotations
 
+import hashlib
 import json
 import shutil
+import subprocess
+import sys
 from collections.abc import Callable
 from pathlib import Path
 
 import pyarrow as pa
+import pyarrow.compute as pc
 import pyarrow.parquet as pq
 import pytest
 
-from sgdata.dataset import write_parquet
+from sgdata.dataset import read_manifest, write_manifest, write_parquet
 from sgdata.errors import DatasetError
 from sgdata.validate import ValidationReport, validate_dataset
 
@@ -41,7 +45,8 @@ def edit_manifest(root: Path, change: Callable[[dict], None]) -> None:
 
 
 def rewrite(root: Path, rel: str, table: pa.Table, *, update_manifest: bool = True) -> None:
-    """Write ``table`` over ``rel``; with ``update_manifest``, fix its rows/sha256/bytes."""
+    """Write ``table`` over ``rel``; with ``update_manifest``, fix its rows/sha256/bytes (and
+    write the card and croissant.json again, as a writer would)."""
     info = write_parquet(table, root / rel)
 
     def fix(raw: dict) -> None:
@@ -51,6 +56,32 @@ def rewrite(root: Path, rel: str, table: pa.Table, *, update_manifest: bool = Tr
 
     if update_manifest:
         edit_manifest(root, fix)
+        write_manifest(read_manifest(root), root)
+
+
+def legacy_dataset(root: Path, *, drop: tuple[str, ...] | list[str] = ()) -> None:
+    """Turn a generated dataset into a format 1.1.0 one, as sgdata 1.x wrote it: images as bare
+    bytes (non-null binary, no huggingface metadata), no card, no croissant.json."""
+    raw = json.loads((root / "dataset.json").read_text())
+    files = []
+    for entry in raw["files"]:
+        path = root / entry["path"]
+        if entry["path"] in ("README.md", "croissant.json"):
+            path.unlink()
+            continue
+        if entry["path"].startswith("observations/"):
+            table = pq.read_table(path).drop_columns(list(drop))
+            at = table.schema.get_field_index("image")
+            doc = {b"doc": table.schema.field("image").metadata[b"doc"]}
+            field = pa.field("image", pa.binary(), nullable=False, metadata=doc)
+            table = table.set_column(at, field, pc.struct_field(table.column("image"), "bytes"))
+            metadata = {k: v for k, v in table.schema.metadata.items() if k != b"huggingface"}
+            pq.write_table(table.replace_schema_metadata(metadata), path)
+            digest = hashlib.sha256(path.read_bytes()).hexdigest()
+            entry.update(sha256=digest, bytes=path.stat().st_size)
+        files.append(entry)
+    raw.update(files=files, format_version="1.1.0")
+    (root / "dataset.json").write_text(json.dumps(raw, indent=2))
 
 
 def rows_of(root: Path, rel: str) -> tuple[list[dict], pa.Schema]:
@@ -237,10 +268,11 @@ def test_room_in_two_splits(copy: Path) -> None:
 
 def test_corrupt_image(copy: Path) -> None:
     table = pq.read_table(copy / SHARD)
-    images = table.column("image").to_pylist()
-    images[2] = b"\x89PNG garbage" + bytes(200)
+    images = table.column("image").to_pylist()  # {bytes, path} on disk
+    images[2] = {"bytes": b"\x89PNG garbage" + bytes(200), "path": None}
     at = table.schema.get_field_index("image")
-    table = table.set_column(at, table.schema.field("image"), pa.array(images, pa.binary()))
+    field = table.schema.field("image")
+    table = table.set_column(at, field, pa.array(images, field.type))
     rewrite(copy, SHARD, table)
     report = validate_dataset(copy)
     assert checks(report) == {"images.decode"}
@@ -258,7 +290,7 @@ def test_manifest_schema_and_version(copy: Path) -> None:
     edit_manifest(copy, lambda raw: raw.update(num_slots="many", format_version="1.0.0"))
     report = validate_dataset(copy, quick=True)
     assert find(report, "manifest.schema")[0].field == "num_slots"
-    edit_manifest(copy, lambda raw: raw.update(format_version="2.0.0"))
+    edit_manifest(copy, lambda raw: raw.update(format_version="3.0.0"))
     report = validate_dataset(copy, quick=True)
     assert "newer" in find(report, "manifest.version")[0].message
 
@@ -315,10 +347,7 @@ def test_a_format_1_0_dataset_without_appearance_columns_still_reads(copy: Path)
     from sgdata.dataset import Dataset
 
     added = ["textures", "light_intensity", "light_temperature"]
-    raw = json.loads((copy / "dataset.json").read_text())
-    for entry in raw["files"]:
-        if entry["path"].startswith("observations/"):
-            rewrite(copy, entry["path"], pq.read_table(copy / entry["path"]).drop_columns(added))
+    legacy_dataset(copy, drop=added)
 
     def as_1_0(raw: dict) -> None:
         raw["format_version"] = "1.0.0"
@@ -333,3 +362,70 @@ def test_a_format_1_0_dataset_without_appearance_columns_still_reads(copy: Path)
     edit_manifest(copy, lambda raw: raw.update(format_version="1.1.0"))
     report = validate_dataset(copy, quick=True)
     assert {p.field for p in find(report, "tables.schema")} == set(added)
+
+
+def test_a_format_1_1_dataset_reads_validates_and_migrates(copy: Path, mini_dataset: Path) -> None:
+    from sgdata.dataset import FORMAT_VERSION, Dataset, migrate_dataset
+
+    legacy_dataset(copy)
+    assert pq.read_schema(copy / SHARD).field("image").type == pa.binary()
+    report = validate_dataset(copy)  # images decoded too
+    assert report.ok, report.problems[:3]
+    assert {"metadata.card", "metadata.croissant"} <= set(report.skipped)
+    old, new = Dataset.open(copy), Dataset.open(mini_dataset)
+    assert old.manifest.format_version == "1.1.0"  # read as it is, not renamed
+    columns = ["obs_id", "image"]
+    assert old.observations("train", columns=columns).equals(
+        new.observations("train", columns=columns)
+    )
+
+    cli = [sys.executable, "-m", "sgdata_cli.sgdata_app", "migrate"]  # the command, end to end
+    done = subprocess.run([*cli, str(copy)], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    manifest = read_manifest(copy)
+    assert manifest.format_version == FORMAT_VERSION
+    report = validate_dataset(copy)
+    assert report.ok and not {"metadata.card", "metadata.croissant"} & set(report.skipped)
+    generated = {f.path: f.sha256 for f in new.manifest.files}
+    migrated = {f.path: f.sha256 for f in manifest.files}
+    assert migrated == generated  # the very bytes generate writes: tables, card, croissant
+    assert (copy / "dataset.json").read_bytes() == (mini_dataset / "dataset.json").read_bytes()
+    assert migrate_dataset(copy) == manifest  # a current dataset: nothing changes
+    done = subprocess.run([*cli, str(copy / "scenes")], capture_output=True, text=True)
+    assert done.returncode != 0 and "no dataset.json" in done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1
+
+
+def test_card_and_croissant_that_disagree_are_reported(copy: Path) -> None:
+    card = copy / "README.md"
+    text = card.read_text()
+    card.write_text(text.replace("num_examples: ", "num_examples: 1", 1))
+    crate = json.loads((copy / "croissant.json").read_text())
+    crate["distribution"][0]["sha256"] = "0" * 64
+    (copy / "croissant.json").write_text(json.dumps(crate))
+    report = validate_dataset(copy, quick=True)
+    assert checks(report) == {"metadata.card", "metadata.croissant", "files.sha256", "files.bytes"}
+    (problem,) = find(report, "metadata.card")
+    assert "num_examples: 1" in problem.message and problem.field.startswith("front matter line")
+    (problem,) = find(report, "metadata.croissant")
+    first = crate["distribution"][0]["@id"]
+    assert problem.field == f"distribution[{first}].sha256"
+    card.unlink()
+    assert "missing" in find(validate_dataset(copy, quick=True), "metadata.card")[0].message
+
+
+def test_a_shard_without_the_huggingface_metadata_is_reported(copy: Path) -> None:
+    table = pq.read_table(copy / SHARD)
+    metadata = {k: v for k, v in table.schema.metadata.items() if k != b"huggingface"}
+    pq.write_table(table.replace_schema_metadata(metadata), copy / SHARD)
+    raw = json.loads((copy / "dataset.json").read_text())
+    for entry in raw["files"]:
+        if entry["path"] == SHARD:
+            data = (copy / SHARD).read_bytes()
+            entry.update(sha256=hashlib.sha256(data).hexdigest(), bytes=len(data))
+    (copy / "dataset.json").write_text(json.dumps(raw, indent=2))
+    write_manifest(read_manifest(copy), copy)  # card and croissant.json follow the new sha256
+    report = validate_dataset(copy, quick=True)
+    (problem,) = find(report, "tables.schema")
+    assert problem.file == SHARD and "'huggingface'" in problem.message
+    assert checks(report) == {"tables.schema"}
