@@ -25,7 +25,6 @@ from torch.utils.data import DataLoader
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-import seannet  # noqa: E402,F401  (imports torch's compiler stack first: see tests/conftest.py)
 from seannet.data.datasets import ImageTransform, TripletDataset, collate_triplets  # noqa: E402
 from seannet.model.loss import TripletLoss  # noqa: E402
 from seannet.model.seannet import SeanNet  # noqa: E402

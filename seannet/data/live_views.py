@@ -17,6 +17,10 @@ from typing import Any
 import numpy as np
 import torch
 
+# Before any EGL context: Mesa's llvmpipe and triton (loaded by torch._dynamo, which
+# torchvision's models import) each bring an LLVM, and loading triton after Mesa segfaults.
+# This module is the only one of seannet that renders, so the order is kept here.
+import torch._dynamo  # noqa: F401  isort: skip
 from seannet.data.datasets import ImageTransform, ViewTensors, open_dataset
 from seannet.data.view_inputs import graph_from_columns
 from seannet.errors import DataError

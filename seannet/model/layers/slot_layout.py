@@ -45,9 +45,10 @@ class SlotLayout(nn.Module):
     Why: a triplet is decided by how the boxes of the *same* objects shifted between two
     views. The GCN pathways squeeze a node to 8 numbers mixed with its neighbours before an
     fc sees any slot, and on `medium` they learned next to nothing of it (a graph-only SeanNet
-    stayed near 60 % triplet accuracy), while this overlap, computed by hand from the boxes
-    of static and low-dynamic objects, ranks 85 % of the test triplets right, and added to a
-    trained ResNet-18's similarity lifts it from 86.9 to 90.5 % (``bench/graph_signal.py``).
+    stayed near 60 % triplet accuracy), while the same objects' box overlap, computed by
+    hand, ranks most triplets right on its own and lifts a trained ResNet-18 when added to
+    its similarity (``resnet18+boxes``, :mod:`seannet.evaluation.box_overlap`; figures in
+    docs/results.md).
 
     Args:
         num_slots: M.

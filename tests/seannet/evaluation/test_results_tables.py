@@ -1,0 +1,65 @@
+"""bench/results.py: docs/results.md's tables are built from run files, stamped, not typed."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+from pathlib import Path
+
+from seannet.evaluation.compare import compare_models
+from seannet.training.config import TrainConfig
+
+ROOT = Path(__file__).resolve().parents[3]
+TINY = TrainConfig().replace(
+    depth=18,
+    image_size=64,
+    roi_size=4,
+    visual_features="c5",
+    embed_dim=64,
+    layout_grid=8,
+    layout_sketch=0,
+    epochs=1,
+    batch_size=4,
+    max_train_batches=1,
+    num_workers=0,
+)
+
+
+def _results_script():  # noqa: ANN202
+    spec = importlib.util.spec_from_file_location("results", ROOT / "bench" / "results.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_tables_are_the_runs_figures(tmp_path: Path, mini_dataset: Path) -> None:
+    results = _results_script()
+    runs = tmp_path / "runs"
+    head = compare_models(
+        mini_dataset,
+        runs,
+        results.HEADLINE,
+        preset=TINY,
+        seeds=(0, 1),
+        lrs=(0.01,),
+        tag="headline",
+    )
+    record = results.provenance(mini_dataset, ["bench/results.py", "run", "tiny"])
+    (runs / "provenance-headline.json").write_text(json.dumps(record))
+    results.noise_step(mini_dataset, runs)
+    doc = results.tables(runs)
+    # the stamp names the code and the data the runs were made with
+    assert f"`{record['commit'][:10]}`" in doc
+    assert record["manifest_sha256"][:16] in doc and "bench/results.py run tiny" in doc
+    # every model's row carries its own figures
+    for entry in head["models"]:
+        s = entry["summary"]
+        row = f"| {entry['model']} | {entry['lr']:g} |"
+        assert row in doc
+        assert f"{100 * s['accuracy']['mean']:.1f} ± {100 * s['accuracy']['ci95']:.1f}" in doc
+    gap = head["models"][1]["difference_to_first"]
+    assert f"{100 * gap['mean']:+.1f} [{100 * gap['low']:+.1f}, {100 * gap['high']:+.1f}]" in doc
+    # the noise table holds the aim's point on every seed of both models
+    noise_rows = [line for line in doc.splitlines() if "(n=2)" in line]
+    assert len(noise_rows) == 2 and all("points |" in line for line in noise_rows)
+    assert "## Ablations" not in doc  # not run: not printed
