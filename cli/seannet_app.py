@@ -298,33 +298,49 @@ def train_navigator_command(
 @app.command()
 def navigate(
     runs: Annotated[list[Path], typer.Argument(help="Localizer run directories.")],
-    navigator: Annotated[Path, typer.Option("--navigator", help="train-navigator run.")],
     data: Data,
+    navigator: Annotated[
+        Path | None, typer.Option("--navigator", help="train-navigator run.")
+    ] = None,
+    oracle: Annotated[
+        bool, typer.Option(help="Navigate with the right action from the true pose instead.")
+    ] = False,
     split: Annotated[str, typer.Option(help="Rooms to test in.")] = "test",
     episodes: Annotated[int, typer.Option(help="Episodes per case (N, A) and room.")] = 20,
     seed: Annotated[int, typer.Option(help="Seed of the episodes.")] = 0,
     spacing: Annotated[int, typer.Option(help="Cells between map nodes.")] = 2,
     epsilon: Epsilon = None,
+    replan: Annotated[
+        bool, typer.Option(help="Also report bump and replan (beyond the paper).")
+    ] = False,
+    workers: Annotated[int, typer.Option(help="Worker processes (rooms in parallel).")] = 1,
     out: Annotated[
         Path | None, typer.Option(help="Where to write (default: the navigator run).")
     ] = None,
     maps: Annotated[Path | None, typer.Option(help="Maps cache (default: OUT/maps).")] = None,
     strips: Annotated[Path | None, typer.Option(help="Save a few episodes as strips.")] = None,
 ) -> None:
-    """The navigation test (paper Table II): success and failure rates, N / A, per localizer."""
-    from seannet.navigation.navigate import HEADER, run_navigation, table_rows
+    """The navigation test (paper Table II): success and failure rates, N / A, per localizer.
+    Resumes where a killed run stopped."""
+    from seannet.errors import NavigationError
+    from seannet.navigation.navigate import run_navigation
+    from seannet.navigation.tables import RATE_HEADER, rate_rows
 
+    if (navigator is None) == (not oracle):
+        raise NavigationError("give one of --navigator RUN and --oracle")
     with console.status("navigate") as status:
         result = run_navigation(
             runs, navigator, data, split=split, episodes=episodes, seed=seed, spacing=spacing,
-            epsilon=epsilon, out=out, maps=maps, strips=strips, progress=status.update,
+            epsilon=epsilon, replan=replan, workers=workers, out=out, maps=maps, strips=strips,
+            progress=status.update,
         )  # fmt: skip
-    table = Table(title=f"navigation on {split} of {data} ({episodes} episodes per case, room)")
-    for column in HEADER:
-        table.add_column(column, justify="right")
-    for row in table_rows(result):
-        table.add_row(*row)
-    console.print(table)
+    for rule in ("paper", "replan") if replan else ("paper",):
+        table = Table(title=f"{rule} rule, {split} of {data} ({episodes} episodes per case, room)")
+        for column in RATE_HEADER:
+            table.add_column(column, justify="right")
+        for row in rate_rows(result, rule):
+            table.add_row(*row)
+        console.print(table)
     console.print(f"wrote {result['written']} and its .json")
 
 

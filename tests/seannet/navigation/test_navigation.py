@@ -4,6 +4,11 @@ and a short end-to-end run on the mini dataset that writes Table II."""
 from __future__ import annotations
 
 import json
+import os
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -13,6 +18,7 @@ import torch
 from seannet.data.live_views import LiveRooms
 from seannet.errors import ModelError, NavigationError
 from seannet.navigation.episodes import (
+    OUTCOMES,
     Step,
     judge_episode,
     judge_segment,
@@ -30,6 +36,7 @@ from seannet.navigation.navigator import (
     label_for,
     load_navigator,
 )
+from seannet.navigation.tables import case_rates
 from seannet.navigation.train_navigator import train_navigator
 from sgdata.seeds import episode_seed, rng_for
 
@@ -103,8 +110,16 @@ def test_every_outcome_from_hand_made_trajectories() -> None:
         judge_segment(GOAL, [on_the_way], EPS)
 
 
+def _without_times(results: dict) -> list:
+    """Every run's episodes without their wall times (the one field that varies)."""
+    return [
+        [{k: v for k, v in e.items() if k != "seconds"} for e in run["episodes"]]
+        for run in results["runs"]
+    ]
+
+
 def test_navigate_end_to_end_writes_table_two(
-    localizer_run: Path, mini_dataset: Path, tmp_path: Path
+    localizer_run: Path, mini_dataset: Path, tmp_path: Path, procs
 ) -> None:
     config = NavigatorConfig(
         image_size=64, hidden=16, epochs=1, batch_size=8, train_pairs=8, val_pairs=4
@@ -114,24 +129,37 @@ def test_navigate_end_to_end_writes_table_two(
     assert load_navigator(tmp_path / "nav").act(
         np.zeros((96, 96, 3), np.uint8), np.zeros((96, 96, 3), np.uint8)
     ) in ("forward", "left", "right")
+    options = {"episodes": 2, "epsilon": 0.95, "replan": True}
     run_navigation(
         [localizer_run],
         tmp_path / "nav",
         mini_dataset,
-        episodes=2,
-        epsilon=0.95,
+        workers=2,
         out=tmp_path / "out",
         strips=tmp_path / "strips",
+        **options,
     )
     written = json.loads((tmp_path / "out" / "navigate_test.json").read_text())
     (run,) = written["runs"]
-    for case in ("N", "A"):
-        row = run["table"][case]
-        assert row["total"] == 2  # one test room, two episodes per case
-        assert sum(row[k] for k in ("success", "navigation", "localization", "collision")) == (
-            pytest.approx(100.0)
-        )
-    assert "| localizer |" in (tmp_path / "out" / "navigate_test.md").read_text()
+    for rule in ("paper", "replan"):
+        table = case_rates(run["episodes"], rule)
+        for case in ("N", "A"):
+            row = table[case]
+            assert row["total"] == 2  # one test room, two episodes per case
+            assert sum(row[k]["percent"] for k in OUTCOMES) == pytest.approx(100.0)
+            # every collision has a cause, every localization failure a kind
+            assert (
+                row["path blocked"]["count"] + row["navigator error"]["count"]
+                == (row["collision"]["count"])
+            )
+            assert (
+                row["false stop"]["count"] + row["missed goal"]["count"]
+                == (row["localization"]["count"])
+            )
+            assert row["success"]["low"] <= row["success"]["percent"] <= row["success"]["high"]
+    text = (tmp_path / "out" / "navigate_test.md").read_text()
+    assert "The paper's rule" in text and "Bump and replan" in text and "render s" in text
+    assert all(e["seconds"]["total"] > 0 for e in run["episodes"])
     assert list((tmp_path / "strips" / localizer_run.name).glob("*.png"))
     # reproducible: the episodes are drawn again from their seeds, with the same paths
     (room_dir,) = (tmp_path / "out" / "maps" / localizer_run.name).iterdir()
@@ -144,3 +172,33 @@ def test_navigate_end_to_end_writes_table_two(
             assert episode.layout == record["layout"] != topo.layout
             if record["case"] == "N":
                 assert len(episode.path) == 2
+
+    # killed (SIGKILL, its workers go with it) after its first part, then resumed: the same
+    # episodes, byte for byte but for wall times, as the uninterrupted run with two workers
+    killed = tmp_path / "killed"
+    command = [
+        sys.executable, "-m", "sgdata_cli.seannet_app", "navigate", str(localizer_run),
+        "--navigator", str(tmp_path / "nav"), "--data", str(mini_dataset), "--episodes", "2",
+        "--epsilon", "0.95", "--replan", "--workers", "1", "--out", str(killed),
+        "--maps", str(tmp_path / "out" / "maps"),
+    ]  # fmt: skip
+    process = subprocess.Popen(
+        command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True
+    )
+    deadline = time.monotonic() + 300
+    while not list((killed / "parts").glob("*/*.json")):
+        assert process.poll() is None, process.stderr.read().decode() if process.stderr else ""
+        assert time.monotonic() < deadline, "no part finished in time"
+        time.sleep(0.05)
+    os.kill(process.pid, signal.SIGKILL)
+    process.wait()
+    assert procs.wait_until_gone(lambda: procs.in_session(process.pid)) == []
+    (first,) = list((killed / "parts").glob("*/*.json"))
+    stamp = first.stat().st_mtime_ns
+    assert not (killed / "navigate_test.json").exists()
+    resumed = run_navigation(
+        [localizer_run], tmp_path / "nav", mini_dataset, workers=1, out=killed,
+        maps=tmp_path / "out" / "maps", **options,
+    )  # fmt: skip
+    assert first.stat().st_mtime_ns == stamp  # the finished part was not run again
+    assert _without_times(resumed) == _without_times(written)
