@@ -267,6 +267,10 @@ def train_navigator_command(
         Path | None, typer.Option(help="Local ImageNet weights of --encoder, sha256-checked.")
     ] = None,
     seed: Annotated[int, typer.Option(help="Seed of pairs, weights and batch order.")] = 0,
+    cache: Annotated[
+        Path | None,
+        typer.Option(help="Rendered pairs, kept and reused (default: OUT/../navigator_pairs)."),
+    ] = None,
 ) -> None:
     """Train the visual navigator (forward / left / right) on pairs rendered from the rooms."""
     from rich.progress import Progress
@@ -285,7 +289,10 @@ def train_navigator_command(
             text = " ".join(f"{k} {v:.3f}" for k, v in metrics.items())
             bar.update(task, description=f"{phase} {text}", completed=step, total=total)
 
-        history = train_navigator(config, data, out, pretrained=pretrained, progress=show)
+        history = train_navigator(
+            config, data, out, cache=cache or out.parent / "navigator_pairs",
+            pretrained=pretrained, progress=show,
+        )  # fmt: skip
     table = Table(title=f"navigator on {data} -> {out}")
     for column in ("epoch", "loss", "train acc", "val acc", "s"):
         table.add_column(column, justify="right")
@@ -293,6 +300,11 @@ def train_navigator_command(
         table.add_row(str(h["epoch"]), f"{h['train_loss']:.4f}", f"{h['train_accuracy']:.3f}",
                       f"{h['val_accuracy']:.3f}", f"{h['seconds']:.0f}")  # fmt: skip
     console.print(table)
+    best = max(history, key=lambda h: h["val_accuracy"])
+    for part in ("val_by_action", "val_by_distance"):
+        if best.get(part):
+            cells = ", ".join(f"{k}: {a:.3f} ({n})" for k, (a, n) in best[part].items())
+            console.print(f"epoch {best['epoch']} {part.replace('_', ' ')}: {cells}")
 
 
 @app.command()

@@ -2,8 +2,9 @@
 
 The network and what it learns from: its config, the label rule and the draw of a training
 pair (the authors: goal within +-2 cells sideways and 0..4 cells forward of the current pose,
-same heading; the label is the larger displacement). Rendering pairs and training are in
-:mod:`seannet.navigation.train_navigator`; :class:`Policy` acts with a trained one.
+same heading; the label is the larger displacement). Rendering pairs is in
+:mod:`seannet.navigation.pairs`, training in :mod:`seannet.navigation.train_navigator`;
+:class:`Policy` acts with a trained one.
 """
 
 from __future__ import annotations
