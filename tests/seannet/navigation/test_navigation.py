@@ -10,6 +10,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -37,7 +38,6 @@ from seannet.navigation.navigator import (
     load_navigator,
 )
 from seannet.navigation.tables import case_rates
-from seannet.navigation.train_navigator import train_navigator
 from sgdata.seeds import episode_seed, rng_for
 
 EPS = 0.9
@@ -119,27 +119,14 @@ def _without_times(results: dict) -> list:
 
 
 def test_navigate_end_to_end_writes_table_two(
-    localizer_run: Path, mini_dataset: Path, tmp_path: Path, procs
+    navigation_run: SimpleNamespace, localizer_run: Path, mini_dataset: Path, tmp_path: Path, procs
 ) -> None:
-    config = NavigatorConfig(
-        image_size=64, hidden=16, epochs=1, batch_size=8, train_pairs=8, val_pairs=4
-    )
-    history = train_navigator(config, mini_dataset, tmp_path / "nav")
-    assert len(history) == 1 and (tmp_path / "nav" / "best.pt").is_file()
-    assert load_navigator(tmp_path / "nav").act(
+    nav, out = navigation_run.navigator, navigation_run.out
+    assert len(navigation_run.history) == 1 and (nav / "best.pt").is_file()
+    assert load_navigator(nav).act(
         np.zeros((96, 96, 3), np.uint8), np.zeros((96, 96, 3), np.uint8)
     ) in ("forward", "left", "right")
-    options = {"episodes": 2, "epsilon": 0.95, "replan": True}
-    run_navigation(
-        [localizer_run],
-        tmp_path / "nav",
-        mini_dataset,
-        workers=2,
-        out=tmp_path / "out",
-        strips=tmp_path / "strips",
-        **options,
-    )
-    written = json.loads((tmp_path / "out" / "navigate_test.json").read_text())
+    written = json.loads((out / "navigate_test.json").read_text())
     (run,) = written["runs"]
     for rule in ("paper", "replan"):
         table = case_rates(run["episodes"], rule)
@@ -157,12 +144,12 @@ def test_navigate_end_to_end_writes_table_two(
                 == (row["localization"]["count"])
             )
             assert row["success"]["low"] <= row["success"]["percent"] <= row["success"]["high"]
-    text = (tmp_path / "out" / "navigate_test.md").read_text()
+    text = (out / "navigate_test.md").read_text()
     assert "The paper's rule" in text and "Bump and replan" in text and "render s" in text
     assert all(e["seconds"]["total"] > 0 for e in run["episodes"])
-    assert list((tmp_path / "strips" / localizer_run.name).glob("*.png"))
+    assert list((navigation_run.strips / localizer_run.name).glob("*.png"))
     # reproducible: the episodes are drawn again from their seeds, with the same paths
-    (room_dir,) = (tmp_path / "out" / "maps" / localizer_run.name).iterdir()
+    (room_dir,) = (out / "maps" / localizer_run.name).iterdir()
     topo = load_map(room_dir)
     with LiveRooms(mini_dataset) as live:
         for record in run["episodes"]:
@@ -178,9 +165,9 @@ def test_navigate_end_to_end_writes_table_two(
     killed = tmp_path / "killed"
     command = [
         sys.executable, "-m", "sgdata_cli.seannet_app", "navigate", str(localizer_run),
-        "--navigator", str(tmp_path / "nav"), "--data", str(mini_dataset), "--episodes", "2",
+        "--navigator", str(nav), "--data", str(mini_dataset), "--episodes", "2",
         "--epsilon", "0.95", "--replan", "--workers", "1", "--out", str(killed),
-        "--maps", str(tmp_path / "out" / "maps"),
+        "--maps", str(out / "maps"),
     ]  # fmt: skip
     process = subprocess.Popen(
         command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True
@@ -197,8 +184,8 @@ def test_navigate_end_to_end_writes_table_two(
     stamp = first.stat().st_mtime_ns
     assert not (killed / "navigate_test.json").exists()
     resumed = run_navigation(
-        [localizer_run], tmp_path / "nav", mini_dataset, workers=1, out=killed,
-        maps=tmp_path / "out" / "maps", **options,
+        [localizer_run], nav, mini_dataset, workers=1, out=killed, maps=out / "maps",
+        **navigation_run.options,
     )  # fmt: skip
     assert first.stat().st_mtime_ns == stamp  # the finished part was not run again
     assert _without_times(resumed) == _without_times(written)

@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import pytest
 
+from seannet.errors import NavigationError
+from seannet.navigation.navigate import run_labels
 from seannet.navigation.tables import case_rates, markdown, wilson
 
 
@@ -63,9 +66,17 @@ def test_rates_split_failures_and_read_each_rule() -> None:
     results = {
         "split": "test", "episodes_per_case_and_room": 4, "k_max": 12, "spacing": 2, "seed": 0,
         "navigator": "nav", "replan": True,
-        "runs": [{"run": "runs/x", "model": "seannet", "epsilon": 0.8, "epsilon_source": "val",
-                  "episodes": records}],
+        "runs": [{"run": "runs/x", "label": "x", "model": "seannet", "epsilon": 0.8,
+                  "epsilon_source": "val", "episodes": records}],
     }  # fmt: skip
     text = markdown(results)
     assert "25.0 [5, 70]" in text  # 1 of 4: Wilson 95 % 4.6 .. 69.9 %
     assert "| seannet (x) | 5 | 0.50 | 0.25 | 0.12 | 1.00 | 3.0 |" in text
+
+
+def test_run_labels_tell_runs_apart(tmp_path: Path) -> None:
+    a, b = tmp_path / "cmp/seannet/lr0.01/seed0", tmp_path / "cmp/resnet18/lr0.003/seed0"
+    assert run_labels([a, tmp_path / "x"]) == ["seed0", "x"]
+    assert run_labels([a, b]) == ["lr0.01_seed0", "lr0.003_seed0"]
+    with pytest.raises(NavigationError, match="twice"):
+        run_labels([a, a])
