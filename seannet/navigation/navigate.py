@@ -3,13 +3,16 @@
 Every localizer run is tested on the same episodes: each is drawn from
 :func:`sgdata.seeds.episode_seed` (test seed, room, case, index) and from the map's structure,
 which is the same whatever run embedded it. Maps are built once per run and room into
-``<maps>/<run name>/<room>/`` and reused (:func:`seannet.navigation.maps.ensure_map`).
+``<maps>/<run label>/<room>/`` and reused (:func:`seannet.navigation.maps.ensure_map`).
+
+A run's label is the shortest tail of its path that tells it from the other runs
+(``seed0``, or ``lr0.01_seed0`` next to ``lr0.003_seed0``).
 
 The work runs in spawned worker processes that die with their parent
 (:func:`sgdata.pipeline.executors.run_tasks`), one task per map, then one per (run, room,
 case), whatever ``workers`` is: every view is rasterised by a single-threaded llvmpipe and
 every network runs on one thread, so the bytes do not depend on the worker count. Each task
-writes its episodes atomically to ``<out>/parts/<run name>/<room>_<case>.json`` with the key
+writes its episodes atomically to ``<out>/parts/<run label>/<room>_<case>.json`` with the key
 of everything they depend on; a run that was killed starts again where it stopped, and a part
 whose key differs is run again.
 """
@@ -39,7 +42,7 @@ from sgdata.fileio import atomic_write_text, save_png
 from sgdata.pipeline.executors import run_tasks
 from sgdata.seeds import episode_seed, rng_for
 
-__all__ = ["ORACLE", "draw_strip", "run_navigation"]
+__all__ = ["ORACLE", "draw_strip", "run_labels", "run_navigation"]
 
 ORACLE = "oracle"  # the navigator that takes the right action from the true pose
 STRIP_EPISODES = 2  # per case, in the split's first room, per run
@@ -112,14 +115,15 @@ def run_navigation(
         "navigator_sha256": file_sha256(navigator / BEST) if navigator is not None else ORACLE,
         "dataset": identity,
     }
+    labels = dict(zip(runs, run_labels(runs), strict=True))
     map_jobs = [
-        (loc.run, data, room_id, maps / loc.run.name / room_id, spacing)
+        (loc.run, data, room_id, maps / labels[loc.run] / room_id, spacing)
         for loc in localizers
         for room_id in rooms
-        if current_map(loc, room_id, maps / loc.run.name / room_id, spacing=spacing) is None
+        if current_map(loc, room_id, maps / labels[loc.run] / room_id, spacing=spacing) is None
     ]
     for done in run_tasks(_map_task, map_jobs, workers=workers):
-        say(f"map of {done['room_id']} by {Path(done['run']).name}")
+        say(f"map of {done['room_id']} by {done['run']}")
     jobs = {
         (loc.run, room_id, case): {
             **settings,
@@ -128,8 +132,9 @@ def run_navigation(
             "epsilon": loc.epsilon,
             "room_id": room_id,
             "case": case,
-            "map": str(maps / loc.run.name / room_id),
-            "strips": str(strips / loc.run.name) if strips is not None and r == 0 else None,
+            "label": labels[loc.run],
+            "map": str(maps / labels[loc.run] / room_id),
+            "strips": str(strips / labels[loc.run]) if strips is not None and r == 0 else None,
         }
         for loc in localizers
         for r, room_id in enumerate(rooms)
@@ -137,7 +142,7 @@ def run_navigation(
     }
     todo = [(job, str(data), str(out)) for job in jobs.values() if _part(job, out) is None]
     for done in run_tasks(_case_task, todo, workers=workers):
-        say(f"{Path(done['run']).name}: {done['room_id']} {done['case']} done")
+        say(f"{done['label']}: {done['room_id']} {done['case']} done")
     results: dict[str, Any] = {**settings, "runs": []}
     for loc in localizers:
         records = []
@@ -151,6 +156,7 @@ def run_navigation(
         results["runs"].append(
             {
                 "run": str(loc.run),
+                "label": labels[loc.run],
                 "model": loc.name,
                 "epsilon": loc.epsilon,
                 "epsilon_source": loc.epsilon_source,
@@ -165,6 +171,22 @@ def run_navigation(
     return results
 
 
+def run_labels(runs: list[Path]) -> list[str]:
+    """The shortest tails of the runs' paths (parts joined by ``_``) that are all different.
+
+    Raises:
+        NavigationError: a run given twice.
+    """
+    paths = [run.resolve() for run in runs]
+    if len(set(paths)) < len(paths):
+        raise NavigationError("a localizer run is given twice; give each once")
+    for k in range(1, max(len(p.parts) for p in paths) + 1):
+        labels = ["_".join(p.parts[-k:]).lstrip("/_") for p in paths]
+        if len(set(labels)) == len(labels):
+            return labels
+    raise NavigationError("localizer runs cannot be told apart by their paths")  # unreachable
+
+
 # What a part depends on: the test's settings, the run and its threshold, the room and case.
 _KEY_FIELDS = (
     "split", "episodes_per_case_and_room", "seed", "k_max", "spacing", "replan",
@@ -177,7 +199,7 @@ def _key(job: dict[str, Any]) -> dict[str, Any]:
 
 
 def _part_path(job: dict[str, Any], out: Path) -> Path:
-    return out / PARTS / Path(job["run"]).name / f"{job['room_id']}_{job['case']}.json"
+    return out / PARTS / job["label"] / f"{job['room_id']}_{job['case']}.json"
 
 
 def _part(job: dict[str, Any], out: Path) -> list[dict[str, Any]] | None:
@@ -237,7 +259,7 @@ def _case_task(job: dict[str, Any], data: str, out: str) -> dict:
                 save_png(strip, Path(job["strips"]) / f"{room_id}_{case}_{index}.png")
     path = _part_path(job, Path(out))
     atomic_write_text(path, json.dumps({"key": _key(job), "episodes": records}))
-    return {"run": job["run"], "room_id": room_id, "case": case}
+    return {"label": job["label"], "room_id": room_id, "case": case}
 
 
 def draw_strip(result: EpisodeResult, goal: np.ndarray) -> Image.Image:

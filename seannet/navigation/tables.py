@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-from pathlib import Path
 from typing import Any
 
 from seannet.navigation.episodes import CASES, CAUSES, LOCALIZATION_KINDS, OUTCOMES
@@ -77,7 +76,7 @@ def _cell(row: dict[str, Any], name: str) -> str:
 
 
 def _label(run: dict[str, Any]) -> str:
-    return f"{run['model']} ({Path(run['run']).name})"
+    return f"{run['model']} ({run['label']})"
 
 
 RATE_HEADER = [
