@@ -271,6 +271,10 @@ def train_navigator_command(
         Path | None,
         typer.Option(help="Rendered pairs, kept and reused (default: OUT/../navigator_pairs)."),
     ] = None,
+    cross_layout: Annotated[
+        float, typer.Option(help="Share of pairs whose goal view is of another layout.")
+    ] = 0.0,
+    jitter: Annotated[float, typer.Option(help="Brightness / contrast jitter, +- share.")] = 0.0,
 ) -> None:
     """Train the visual navigator (forward / left / right) on pairs rendered from the rooms."""
     from rich.progress import Progress
@@ -280,7 +284,8 @@ def train_navigator_command(
 
     config = NavigatorConfig(
         encoder=encoder, image_size=image_size, epochs=epochs, batch_size=batch_size,
-        train_pairs=pairs, val_pairs=val_pairs, seed=seed,
+        train_pairs=pairs, val_pairs=val_pairs, seed=seed, cross_layout=cross_layout,
+        jitter=jitter,
     )  # fmt: skip
     with Progress(console=console, transient=True) as bar:
         task = bar.add_task("render pairs", total=None)

@@ -31,7 +31,7 @@ from sgdata.seeds import navigator_pairs_seed, rng_for
 
 __all__ = ["PairSet", "pairs_key", "render_pairs"]
 
-PAIRS_FORMAT = 1  # bump when a cached file's arrays change
+PAIRS_FORMAT = 2  # bump when a cached file's arrays change
 _FIELDS = ("current", "goal", "labels", "poses", "rooms")
 
 
@@ -42,7 +42,7 @@ class PairSet:
     current: np.ndarray  # (N, S, S, 3) uint8
     goal: np.ndarray  # (N, S, S, 3) uint8
     labels: np.ndarray  # (N,) int64, an index of NAVIGATOR_ACTIONS
-    poses: np.ndarray  # (N, 7) int64: layout, current (i, j, h), goal (i, j, h)
+    poses: np.ndarray  # (N, 8) int64: layout, current (i, j, h), goal layout, goal (i, j, h)
     rooms: np.ndarray  # (N,) str
 
     def __len__(self) -> int:
@@ -55,7 +55,7 @@ class PairSet:
     def distances(self) -> np.ndarray:
         """(N,) cells from current to goal (|forward| + |side|)."""
         return np.array(
-            [sum(map(abs, local_offset(tuple(p[1:4]), tuple(p[4:6])))) for p in self.poses],
+            [sum(map(abs, local_offset(tuple(p[1:4]), tuple(p[5:7])))) for p in self.poses],
             dtype=np.int64,
         )
 
@@ -74,6 +74,7 @@ def pairs_key(config: NavigatorConfig, split: str, count: int, identity: dict[st
         "image_size": config.image_size,
         "max_side": config.max_side,
         "max_forward": config.max_forward,
+        "cross_layout": config.cross_layout,
     }
 
 
@@ -124,31 +125,43 @@ def render_pairs(
 def _render_room(
     live: LiveRooms, split: str, room_id: str, count: int, config: NavigatorConfig
 ) -> PairSet:
-    """``count`` draws in one room (fewer where draws fail), rendered."""
+    """``count`` draws in one room (fewer where draws fail), rendered layout by layout."""
     rng = rng_for(navigator_pairs_seed(config.seed, split, room_id))
     layouts = live.layouts(room_id)
     wanted = [layouts[int(k)] for k in rng.integers(len(layouts), size=count)]
-    draws = []
-    for layout in sorted(set(wanted)):
+    masks = {}
+    for layout in layouts:
         live.load(room_id, layout)
+        masks[layout] = live.grid.reachable.copy()
+    draws = []  # (layout, current, goal layout, goal, label)
+    for layout in sorted(set(wanted)):
         for _ in range(wanted.count(layout)):
             pair = draw_pair(
-                live.grid.reachable, rng, max_side=config.max_side, max_forward=config.max_forward
+                masks[layout], rng, max_side=config.max_side, max_forward=config.max_forward
             )
-            if pair is not None:
-                draws.append((layout, *pair))
+            if pair is None:
+                continue
+            a, b, label = pair
+            goal_layout = layout
+            # drawn only when asked, so the pairs without it stay what they were
+            if config.cross_layout > 0 and len(layouts) > 1 and rng.random() < config.cross_layout:
+                other = [k for k in layouts if k != layout][int(rng.integers(len(layouts) - 1))]
+                if masks[other][b[0], b[1]]:  # not inside an object that moved there
+                    goal_layout = other
+            draws.append((layout, a, goal_layout, b, label))
     s = config.image_size
     current = np.zeros((len(draws), s, s, 3), dtype=np.uint8)
     goal = np.zeros_like(current)
-    for n, (layout, a, b, _) in enumerate(draws):
+    views = [(d[0], n, d[1], current) for n, d in enumerate(draws)]
+    views += [(d[2], n, d[3], goal) for n, d in enumerate(draws)]
+    for layout, n, pose, into in sorted(views, key=lambda v: (v[0], v[3] is goal, v[1])):
         live.load(room_id, layout)
-        current[n] = resize(live.image(*a), s)
-        goal[n] = resize(live.image(*b), s)
+        into[n] = resize(live.image(*pose), s)
     return PairSet(
         current=current,
         goal=goal,
-        labels=np.array([d[3] for d in draws], dtype=np.int64),
-        poses=np.array([(d[0], *d[1], *d[2]) for d in draws], dtype=np.int64).reshape(-1, 7),
+        labels=np.array([d[4] for d in draws], dtype=np.int64),
+        poses=np.array([(d[0], *d[1], d[2], *d[3]) for d in draws], dtype=np.int64).reshape(-1, 8),
         rooms=np.array([room_id] * len(draws), dtype=str),
     )
 

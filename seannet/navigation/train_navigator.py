@@ -6,7 +6,9 @@ epoch and by later runs with the same key). The batch order of each epoch comes 
 :func:`sgdata.seeds.navigator_order_seed`; the training goes through
 :func:`seannet.training.loop.train_one_epoch` and the val accuracy through
 :func:`seannet.training.loop.collect`. ``best.pt`` is the epoch of the best val accuracy, which
-is also reported per action and per goal distance. Cross-entropy, SGD.
+is also reported per action and per goal distance. Cross-entropy, SGD. What the test changes
+can be trained for: goal views of another layout (``cross_layout``, in the pairs) and light
+jitter per view (``jitter``, per epoch from :func:`sgdata.seeds.navigator_jitter_seed`).
 """
 
 from __future__ import annotations
@@ -31,9 +33,14 @@ from seannet.navigation.pairs import PairSet, render_pairs
 from seannet.training.loop import Progress, collect, train_one_epoch
 from seannet.training.runs import BEST, HISTORY, LAST, device_for_run, save_checkpoint
 from sgdata.fileio import atomic_write_text
-from sgdata.seeds import navigator_init_seed, navigator_order_seed
+from sgdata.seeds import (
+    navigator_init_seed,
+    navigator_jitter_seed,
+    navigator_order_seed,
+    rng_for,
+)
 
-__all__ = ["pair_accuracy", "train_navigator"]
+__all__ = ["jitter", "pair_accuracy", "train_navigator"]
 
 
 def train_navigator(
@@ -85,9 +92,16 @@ def train_navigator(
         started = time.perf_counter()
         order = torch.Generator().manual_seed(navigator_order_seed(config.seed, epoch))
         indices = torch.randperm(len(train_set), generator=order).numpy()
+        batches = _pair_batches(train_set.arrays(), indices, config.batch_size)
+        if config.jitter:
+            light = rng_for(navigator_jitter_seed(config.seed, epoch))
+            batches = (
+                (jitter(a, light, config.jitter), jitter(b, light, config.jitter), y)
+                for a, b, y in batches
+            )
         loss, train_acc = train_one_epoch(
             model,
-            _pair_batches(train_set.arrays(), indices, config.batch_size),
+            batches,
             _cross_entropy_step(model, device),
             optimizer,
             total=math.ceil(len(indices) / config.batch_size),
@@ -112,6 +126,7 @@ def train_navigator(
             "dataset": identity,
             "epoch": epoch,
             "model": model.state_dict(),
+            "pretrained": None if pretrained is None else str(pretrained),  # ImageNet init
             "history": history,
             "best": max(best, val_acc),
         }
@@ -151,6 +166,17 @@ def pair_accuracy(
     }
 
 
+def jitter(images: np.ndarray, rng: np.random.Generator, amount: float) -> np.ndarray:
+    """(B, S, S, 3) uint8 views, each with its brightness and contrast scaled by its own
+    factors within ``1 +- amount``: the light of another layout."""
+    x = images.astype(np.float32)
+    size = (len(x), 1, 1, 1)
+    brightness = rng.uniform(1 - amount, 1 + amount, size=size)
+    contrast = rng.uniform(1 - amount, 1 + amount, size=size)
+    mean = x.mean(axis=(1, 2, 3), keepdims=True)
+    return np.clip((x - mean) * contrast + mean * brightness, 0, 255).round().astype(np.uint8)
+
+
 def _pair_batches(
     pairs: tuple[np.ndarray, np.ndarray, np.ndarray], order: np.ndarray, size: int
 ) -> Iterator[tuple[np.ndarray, np.ndarray, np.ndarray]]:
@@ -163,7 +189,7 @@ def _logits_and_labels(
     model: VisualNavigator, device: torch.device, batch: tuple[np.ndarray, ...]
 ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
     """(logits, labels, correct) of a batch of (current, goal, label) arrays."""
-    a, b = (navigator_inputs(x).to(device) for x in batch[:2])
+    a, b = (navigator_inputs(x, model.encoder_name).to(device) for x in batch[:2])
     y = torch.from_numpy(batch[2]).to(device)
     logits = model(a, b)
     return logits, y, (logits.argmax(1) == y)

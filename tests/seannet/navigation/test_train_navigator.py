@@ -10,9 +10,14 @@ import pytest
 
 from seannet.data.datasets import dataset_identity
 from seannet.data.live_views import LiveRooms
-from seannet.navigation.navigator import NavigatorConfig, load_navigator
+from seannet.navigation.navigator import (
+    NavigatorConfig,
+    VisualNavigator,
+    load_navigator,
+    navigator_inputs,
+)
 from seannet.navigation.pairs import render_pairs
-from seannet.navigation.train_navigator import pair_accuracy, train_navigator
+from seannet.navigation.train_navigator import jitter, pair_accuracy, train_navigator
 from seannet.training.runs import load_checkpoint
 
 CONFIG = NavigatorConfig(
@@ -72,3 +77,24 @@ def test_pairs_are_cached_and_val_pairs_are_never_trained_on(
     assert all(
         1 <= int(d) <= CONFIG.max_forward + CONFIG.max_side for d in report["val_by_distance"]
     )
+
+
+def test_what_the_test_changes_can_be_trained_for(mini_dataset: Path) -> None:
+    # light: each view its own brightness and contrast, drawn from the epoch's stream
+    views = np.random.default_rng(0).integers(0, 256, size=(4, 8, 8, 3), dtype=np.uint8)
+    assert np.array_equal(jitter(views, np.random.default_rng(1), 0.0), views)
+    a, b = (jitter(views, np.random.default_rng(1), 0.3) for _ in range(2))
+    assert np.array_equal(a, b) and not np.array_equal(a, views) and a.dtype == np.uint8
+    # moved objects, their looks, the light: goal views of another layout, same label rule
+    config = CONFIG.replace(cross_layout=1.0)
+    with LiveRooms(mini_dataset) as live:
+        pairs = render_pairs(live, "val", 8, config)
+        same = render_pairs(live, "val", 8, CONFIG)
+    crossed = pairs.poses[:, 0] != pairs.poses[:, 4]
+    assert crossed.sum() >= len(pairs) // 2  # where the goal cell is free in the other layout
+    assert (same.poses[:, 0] == same.poses[:, 4]).all()
+    assert set(pairs.distances().tolist()) <= set(range(1, 7))
+    # an ImageNet-initialised encoder (EfficientNet-Lite0, its own input normalisation)
+    net = VisualNavigator("efficientnet_lite0", hidden=16, pretrained=Path("imagenet-lite0"))
+    inputs = navigator_inputs(pairs.current[:2], "efficientnet_lite0")
+    assert inputs.min() >= -1.0 and net(inputs, inputs).shape == (2, 3)
