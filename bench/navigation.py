@@ -2,7 +2,8 @@
 
     python bench/navigation.py run DATA OUT --localizer RUN [--localizer RUN ...]
         [--pairs 20000] [--val-pairs 2000] [--image-size 96] [--epochs 10] [--episodes 20]
-        [--workers 2]
+        [--workers 2] [--encoder resnet18] [--pretrained imagenet-lite0] [--cross-layout 0.5]
+        [--jitter 0.2]
     python bench/navigation.py tables [OUT] [-o docs/navigation.md]
 
 ``run`` records what made the runs (commit, command, dataset manifest sha256 and format
@@ -63,14 +64,18 @@ def run(args: argparse.Namespace) -> None:
     out.mkdir(parents=True, exist_ok=True)
     atomic_write_text(out / PROVENANCE, json.dumps(provenance(args.data, sys.argv), indent=2))
     config = NavigatorConfig(
+        encoder=args.encoder,
         image_size=args.image_size,
         epochs=args.epochs,
         train_pairs=args.pairs,
         val_pairs=args.val_pairs,
+        cross_layout=args.cross_layout,
+        jitter=args.jitter,
     )
     navigator = out / "navigator"
     if not (navigator / BEST).is_file():
-        train_navigator(config, args.data, navigator, cache=out / "navigator_pairs")
+        cache = out / "navigator_pairs"
+        train_navigator(config, args.data, navigator, cache=cache, pretrained=args.pretrained)
     run_navigation(
         args.localizer,
         navigator,
@@ -106,7 +111,9 @@ def measured_block(out: Path) -> str:
     made = json.loads((out / PROVENANCE).read_text())
     results = json.loads((out / "navigate" / f"navigate_{SPLIT}.json").read_text())
     history = json.loads((out / "navigator" / HISTORY).read_text())
-    config = load_checkpoint(out / "navigator" / BEST)["config"]
+    state = load_checkpoint(out / "navigator" / BEST)
+    config = state["config"]
+    init = f"ImageNet init {state['pretrained']}" if state.get("pretrained") else "random init"
     best = max(history, key=lambda h: h["val_accuracy"])
     dirty = " with uncommitted changes" if made["dirty"] else ""
     lines = [
@@ -115,7 +122,10 @@ def measured_block(out: Path) -> str:
         f"`{made['command']}`.",
         "",
         f"Navigator: {best['train_pairs']:,} train pairs at {config['image_size']} px, "
-        f"{config['encoder']}; best epoch {best['epoch'] + 1} of {len(history)}, val accuracy "
+        f"{config['encoder']} ({init}), goals of another layout "
+        f"{100 * config.get('cross_layout', 0.0):.0f} %, light jitter ±"
+        f"{100 * config.get('jitter', 0.0):.0f} %; best epoch {best['epoch'] + 1} of "
+        f"{len(history)}, val accuracy "
         f"{100 * best['val_accuracy']:.1f} % on {best.get('val_pairs', 0):,} val pairs.",
     ]
     for part, what in (("val_by_action", "action"), ("val_by_distance", "goal distance, cells")):
@@ -179,6 +189,10 @@ def main(argv: list[str] | None = None) -> None:
     go.add_argument("--val-pairs", type=int, default=2000)
     go.add_argument("--image-size", type=int, default=96)
     go.add_argument("--epochs", type=int, default=10)
+    go.add_argument("--encoder", default="resnet18")
+    go.add_argument("--pretrained", type=Path, help="ImageNet init, e.g. imagenet-lite0")
+    go.add_argument("--cross-layout", type=float, default=0.0)
+    go.add_argument("--jitter", type=float, default=0.0)
     go.add_argument("--episodes", type=int, default=20)
     go.add_argument("--workers", type=int, default=2)
     tables = sub.add_parser("tables", help="write docs/navigation.md's tables")

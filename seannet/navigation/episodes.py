@@ -334,6 +334,9 @@ def run_episode(
     used = replans = n = 0
     verdict: str | None = REACHED
     while n < len(plan) - 1:
+        if used >= budget:  # --replan: the episode's steps are spent
+            verdict = None
+            break
         a, b = plan[n], plan[n + 1]
         goal_vector, goal_image = topo.embedding(b), topo.image(b)
         steps: list[Step] = []
