@@ -45,7 +45,6 @@ from sgdata.seeds import episode_seed, rng_for
 __all__ = ["ORACLE", "draw_strip", "run_labels", "run_navigation"]
 
 ORACLE = "oracle"  # the navigator that takes the right action from the true pose
-STRIP_EPISODES = 2  # per case, in the split's first room, per run
 STRIP_PANEL = 112  # pixels
 STRIP_MAX_PANELS = 16
 PARTS = "parts"
@@ -78,7 +77,8 @@ def run_navigation(
         workers: processes running maps and episodes in parallel.
 
     Writes ``navigate_<split>.json`` and ``.md`` into ``out`` (default: the navigator run),
-    maps under ``maps`` (default: ``out/maps``), strips under ``strips`` when given.
+    maps under ``maps`` (default: ``out/maps``), and under ``strips`` when given, per run,
+    room and case, the first episode of each outcome (and cause or kind) as a strip.
 
     Raises:
         CheckpointError: a run or the navigator was trained on another dataset.
@@ -134,10 +134,10 @@ def run_navigation(
             "case": case,
             "label": labels[loc.run],
             "map": str(maps / labels[loc.run] / room_id),
-            "strips": str(strips / labels[loc.run]) if strips is not None and r == 0 else None,
+            "strips": str(strips / labels[loc.run]) if strips is not None else None,
         }
         for loc in localizers
-        for r, room_id in enumerate(rooms)
+        for room_id in rooms
         for case in CASES
     }
     todo = [(job, str(data), str(out)) for job in jobs.values() if _part(job, out) is None]
@@ -241,11 +241,12 @@ def _case_task(job: dict[str, Any], data: str, out: str) -> dict:
     check_map(topo, localizer, directory)
     room_id, case = job["room_id"], job["case"]
     records = []
+    drawn: set[str] = set()  # the outcome kinds drawn as strips already
     with LiveRooms(Path(data)) as live:
         for index in range(job["episodes_per_case_and_room"]):
             rng = rng_for(episode_seed(job["seed"], room_id, case, index))
             episode = sample_episode(topo, live, case, rng, index=index)
-            keep = job["strips"] is not None and index < STRIP_EPISODES
+            keep = job["strips"] is not None
             started = time.perf_counter()
             result = run_episode(
                 episode, topo, live, localizer, policy,
@@ -254,9 +255,11 @@ def _case_task(job: dict[str, Any], data: str, out: str) -> dict:
             record = result.to_dict()
             record["seconds"]["total"] = time.perf_counter() - started
             records.append(record)
-            if keep:
+            kind = "_".join(str(k).replace(" ", "-") for k in (result.outcome, result.detail) if k)
+            if keep and kind not in drawn:  # the first episode of each kind (the paper's Fig. 9)
+                drawn.add(kind)
                 strip = draw_strip(result, topo.image(episode.path[-1]))
-                save_png(strip, Path(job["strips"]) / f"{room_id}_{case}_{index}.png")
+                save_png(strip, Path(job["strips"]) / f"{room_id}_{case}_{index}_{kind}.png")
     path = _part_path(job, Path(out))
     atomic_write_text(path, json.dumps({"key": _key(job), "episodes": records}))
     return {"label": job["label"], "room_id": room_id, "case": case}

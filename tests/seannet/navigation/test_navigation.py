@@ -147,7 +147,13 @@ def test_navigate_end_to_end_writes_table_two(
     text = (out / "navigate_test.md").read_text()
     assert "The paper's rule" in text and "Bump and replan" in text and "render s" in text
     assert all(e["seconds"]["total"] > 0 for e in run["episodes"])
-    assert list((navigation_run.strips / localizer_run.name).glob("*.png"))
+    # a strip of the first episode of each outcome and kind, per room and case
+    expected = {}
+    for e in run["episodes"]:
+        kind = "_".join(str(k).replace(" ", "-") for k in (e["outcome"], e["detail"]) if k)
+        expected.setdefault((e["room_id"], e["case"], kind), e["index"])
+    strips = {p.stem for p in (navigation_run.strips / localizer_run.name).glob("*.png")}
+    assert strips == {f"{r}_{c}_{i}_{k}" for (r, c, k), i in expected.items()}
     # reproducible: the episodes are drawn again from their seeds, with the same paths
     (room_dir,) = (out / "maps" / localizer_run.name).iterdir()
     topo = load_map(room_dir)
@@ -189,3 +195,13 @@ def test_navigate_end_to_end_writes_table_two(
     )  # fmt: skip
     assert first.stat().st_mtime_ns == stamp  # the finished part was not run again
     assert _without_times(resumed) == _without_times(written)
+
+
+def test_navigate_wants_a_navigator_or_the_oracle(localizer_run: Path, mini_dataset: Path) -> None:
+    command = [sys.executable, "-m", "sgdata_cli.seannet_app", "navigate", str(localizer_run)]
+    result = subprocess.run(
+        [*command, "--data", str(mini_dataset)], capture_output=True, text=True, timeout=300
+    )
+    assert result.returncode != 0 and "Traceback" not in result.stderr
+    (line,) = result.stderr.strip().splitlines()
+    assert "--navigator RUN" in line and "--oracle" in line
