@@ -208,7 +208,7 @@ class Timing:
     embed: float = 0.0
     navigator: float = 0.0
 
-    def clock(self, part: str, fn: Callable[..., Any], *args: Any) -> Any:
+    def timed(self, part: str, fn: Callable[..., Any], *args: Any) -> Any:
         """``fn(*args)``, its wall time added to ``part``."""
         started = time.perf_counter()
         value = fn(*args)
@@ -324,7 +324,7 @@ def run_episode(
     live.load(episode.room_id, episode.layout)
     clock = Timing()
     pose = episode.path[0]
-    current = clock.clock("render", live.view, *pose)
+    current = clock.timed("render", live.view, *pose)
     vector: np.ndarray | None = None  # the current view's embedding, once computed
     frames = [current.rgb] if keep_frames else []
     plan = list(episode.path)
@@ -347,15 +347,15 @@ def run_episode(
             elif policy is None:
                 action = ideal_action(pose, b)
             else:
-                action = clock.clock("navigator", policy.act, current.rgb, goal_image)
+                action = clock.timed("navigator", policy.act, current.rgb, goal_image)
             nxt = apply(pose, action)
             if action not in TURNS and not live.reachable(nxt[0], nxt[1]):
                 cause = collision_cause(pose, a, b, live.reachable)
                 steps.append(Step(action, nxt, collided=True, cause=cause))
             else:
                 pose = nxt
-                current = clock.clock("render", live.view, *pose)
-                vector = clock.clock("embed", _embed, localizer, live, current)
+                current = clock.timed("render", live.view, *pose)
+                vector = clock.timed("embed", _embed, localizer, live, current)
                 steps.append(Step(action, pose, similarity=float(vector @ goal_vector)))
                 if keep_frames:
                     frames.append(current.rgb)
@@ -368,7 +368,7 @@ def run_episode(
         if verdict == "collision" and replan and used < budget:
             avoid.add(frozenset((a[:2], b[:2])))
             if vector is None:  # bumped on the first move: the start view is not embedded yet
-                vector = clock.clock("embed", _embed, localizer, live, current)
+                vector = clock.timed("embed", _embed, localizer, live, current)
             here = topo.sub_nodes()[int(np.argmax(topo.embeddings @ vector))]
             new = _replan(topo, here, plan[-1], avoid)
             if new is not None:
