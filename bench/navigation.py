@@ -39,6 +39,7 @@ from seannet.navigation.tables import (  # noqa: E402
     SPLIT_HEADER,
     TIME_HEADER,
     rate_rows,
+    read_results,
     time_rows,
 )
 from seannet.navigation.train_navigator import train_navigator  # noqa: E402
@@ -109,7 +110,7 @@ def paper_rows() -> list[list[str]]:
 def measured_block(out: Path) -> str:
     """The tables of ``out``'s runs, stamped with what made them."""
     made = json.loads((out / PROVENANCE).read_text())
-    results = json.loads((out / "navigate" / f"navigate_{SPLIT}.json").read_text())
+    results = read_results(out / "navigate" / f"navigate_{SPLIT}.json")
     history = json.loads((out / "navigator" / HISTORY).read_text())
     state = load_checkpoint(out / "navigator" / BEST)
     config = state["config"]

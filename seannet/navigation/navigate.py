@@ -11,10 +11,12 @@ A run's label is the shortest tail of its path that tells it from the other runs
 The work runs in spawned worker processes that die with their parent
 (:func:`sgdata.pipeline.executors.run_tasks`), one task per map, then one per (run, room,
 case), whatever ``workers`` is: every view is rasterised by a single-threaded llvmpipe and
-every network runs on one thread, so the bytes do not depend on the worker count. Each task
+every network runs on one thread, so the results do not depend on the worker count. Each task
 writes its episodes atomically to ``<out>/parts/<run label>/<room>_<case>.json`` with the key
 of everything they depend on; a run that was killed starts again where it stopped, and a part
-whose key differs is run again.
+whose key differs is run again. Wall times are the one thing that varies: they are written
+to ``navigate_<split>_times.json``, beside ``navigate_<split>.json``, which holds the same
+bytes for the same settings whatever the worker count or the interruptions.
 """
 
 from __future__ import annotations
@@ -36,7 +38,7 @@ from seannet.navigation.episodes import CASES, K_MAX, EpisodeResult, run_episode
 from seannet.navigation.localizer import Localizer, load_localizer
 from seannet.navigation.maps import check_map, current_map, ensure_map, load_map
 from seannet.navigation.navigator import load_navigator, resize
-from seannet.navigation.tables import markdown
+from seannet.navigation.tables import markdown, write_results
 from seannet.training.runs import BEST, check_same_dataset, load_checkpoint
 from sgdata.fileio import atomic_write_text, save_png
 from sgdata.pipeline.executors import run_tasks
@@ -165,7 +167,7 @@ def run_navigation(
             }
         )
     out.mkdir(parents=True, exist_ok=True)
-    atomic_write_text(out / f"navigate_{split}.json", json.dumps(results, indent=1))
+    write_results(results, out / f"navigate_{split}.json")
     atomic_write_text(out / f"navigate_{split}.md", markdown(results))
     results["written"] = str(out / f"navigate_{split}.md")
     return results

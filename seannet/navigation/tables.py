@@ -1,11 +1,17 @@
-"""Table II from episode records: rates with Wilson 95 % intervals, failure splits, time."""
+"""Table II from episode records: rates with Wilson 95 % intervals, failure splits, time;
+the results file and its wall times, written apart and read back together."""
 
 from __future__ import annotations
 
+import copy
+import json
 import math
+from pathlib import Path
 from typing import Any
 
+from seannet.errors import NavigationError
 from seannet.navigation.episodes import CASES, CAUSES, LOCALIZATION_KINDS, OUTCOMES
+from sgdata.fileio import atomic_write_text
 
 __all__ = [
     "RULES",
@@ -13,8 +19,10 @@ __all__ = [
     "case_rates",
     "markdown",
     "rate_rows",
+    "read_results",
     "time_rows",
     "wilson",
+    "write_results",
 ]
 
 Z95 = 1.959963984540054  # the standard normal's 97.5 % quantile
@@ -154,3 +162,39 @@ def markdown(results: dict[str, Any]) -> str:
         *(f"| {_label(r)} | {r['epsilon']:.3f} | {r['epsilon_source']} |" for r in results["runs"]),
     ]
     return "\n".join(lines) + "\n"
+
+
+def _times_path(path: Path) -> Path:
+    return path.with_name(f"{path.stem}_times.json")
+
+
+def write_results(results: dict[str, Any], path: Path) -> None:
+    """``path`` (every episode without its wall times: the same bytes for the same settings)
+    and ``<stem>_times.json`` (the times, per run, in episode order), each atomically."""
+    plain = copy.deepcopy({k: v for k, v in results.items() if k != "written"})
+    times = []
+    for run in plain["runs"]:
+        times.append(
+            {"label": run["label"], "seconds": [e.pop("seconds") for e in run["episodes"]]}
+        )
+    atomic_write_text(path, json.dumps(plain, indent=1))
+    atomic_write_text(_times_path(path), json.dumps({"runs": times}, indent=1))
+
+
+def read_results(path: Path) -> dict[str, Any]:
+    """A results file with its wall times put back (:func:`write_results`).
+
+    Raises:
+        NavigationError: either file is missing or unreadable, or they do not match.
+    """
+    try:
+        results = json.loads(path.read_text())
+        times = json.loads(_times_path(path).read_text())["runs"]
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise NavigationError(f"{path}: unreadable navigation results ({exc})") from None
+    for run, timed in zip(results["runs"], times, strict=True):
+        if run["label"] != timed["label"] or len(run["episodes"]) != len(timed["seconds"]):
+            raise NavigationError(f"{_times_path(path)}: does not match {path.name}")
+        for episode, seconds in zip(run["episodes"], timed["seconds"], strict=True):
+            episode["seconds"] = seconds
+    return results

@@ -39,7 +39,8 @@ def test_tables_from_tiny_runs(
     out = tmp_path / "bench"
     shutil.copytree(navigation_run.navigator, out / "navigator")
     (out / "navigate").mkdir()
-    shutil.copy(navigation_run.out / "navigate_test.json", out / "navigate")
+    for name in ("navigate_test.json", "navigate_test_times.json"):
+        shutil.copy(navigation_run.out / name, out / "navigate")
     made = bench.provenance(mini_dataset, ["bench/navigation.py", "run", "tiny"])
     (out / bench.PROVENANCE).write_text(json.dumps(made))
     doc = tmp_path / "navigation.md"
