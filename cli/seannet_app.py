@@ -267,6 +267,14 @@ def train_navigator_command(
         Path | None, typer.Option(help="Local ImageNet weights of --encoder, sha256-checked.")
     ] = None,
     seed: Annotated[int, typer.Option(help="Seed of pairs, weights and batch order.")] = 0,
+    cache: Annotated[
+        Path | None,
+        typer.Option(help="Rendered pairs, kept and reused (default: OUT/../navigator_pairs)."),
+    ] = None,
+    cross_layout: Annotated[
+        float, typer.Option(help="Share of pairs whose goal view is of another layout.")
+    ] = 0.0,
+    jitter: Annotated[float, typer.Option(help="Brightness / contrast jitter, +- share.")] = 0.0,
 ) -> None:
     """Train the visual navigator (forward / left / right) on pairs rendered from the rooms."""
     from rich.progress import Progress
@@ -276,7 +284,8 @@ def train_navigator_command(
 
     config = NavigatorConfig(
         encoder=encoder, image_size=image_size, epochs=epochs, batch_size=batch_size,
-        train_pairs=pairs, val_pairs=val_pairs, seed=seed,
+        train_pairs=pairs, val_pairs=val_pairs, seed=seed, cross_layout=cross_layout,
+        jitter=jitter,
     )  # fmt: skip
     with Progress(console=console, transient=True) as bar:
         task = bar.add_task("render pairs", total=None)
@@ -285,7 +294,10 @@ def train_navigator_command(
             text = " ".join(f"{k} {v:.3f}" for k, v in metrics.items())
             bar.update(task, description=f"{phase} {text}", completed=step, total=total)
 
-        history = train_navigator(config, data, out, pretrained=pretrained, progress=show)
+        history = train_navigator(
+            config, data, out, cache=cache or out.parent / "navigator_pairs",
+            pretrained=pretrained, progress=show,
+        )  # fmt: skip
     table = Table(title=f"navigator on {data} -> {out}")
     for column in ("epoch", "loss", "train acc", "val acc", "s"):
         table.add_column(column, justify="right")
@@ -293,38 +305,59 @@ def train_navigator_command(
         table.add_row(str(h["epoch"]), f"{h['train_loss']:.4f}", f"{h['train_accuracy']:.3f}",
                       f"{h['val_accuracy']:.3f}", f"{h['seconds']:.0f}")  # fmt: skip
     console.print(table)
+    best = max(history, key=lambda h: h["val_accuracy"])
+    for part in ("val_by_action", "val_by_distance"):
+        if best.get(part):
+            cells = ", ".join(f"{k}: {a:.3f} ({n})" for k, (a, n) in best[part].items())
+            console.print(f"epoch {best['epoch']} {part.replace('_', ' ')}: {cells}")
 
 
 @app.command()
 def navigate(
     runs: Annotated[list[Path], typer.Argument(help="Localizer run directories.")],
-    navigator: Annotated[Path, typer.Option("--navigator", help="train-navigator run.")],
     data: Data,
+    navigator: Annotated[
+        Path | None, typer.Option("--navigator", help="train-navigator run.")
+    ] = None,
+    oracle: Annotated[
+        bool, typer.Option(help="Navigate with the right action from the true pose instead.")
+    ] = False,
     split: Annotated[str, typer.Option(help="Rooms to test in.")] = "test",
     episodes: Annotated[int, typer.Option(help="Episodes per case (N, A) and room.")] = 20,
     seed: Annotated[int, typer.Option(help="Seed of the episodes.")] = 0,
     spacing: Annotated[int, typer.Option(help="Cells between map nodes.")] = 2,
     epsilon: Epsilon = None,
+    replan: Annotated[
+        bool, typer.Option(help="Also report bump and replan (beyond the paper).")
+    ] = False,
+    workers: Annotated[int, typer.Option(help="Worker processes (rooms in parallel).")] = 1,
     out: Annotated[
         Path | None, typer.Option(help="Where to write (default: the navigator run).")
     ] = None,
     maps: Annotated[Path | None, typer.Option(help="Maps cache (default: OUT/maps).")] = None,
     strips: Annotated[Path | None, typer.Option(help="Save a few episodes as strips.")] = None,
 ) -> None:
-    """The navigation test (paper Table II): success and failure rates, N / A, per localizer."""
-    from seannet.navigation.navigate import HEADER, run_navigation, table_rows
+    """The navigation test (paper Table II): success and failure rates, N / A, per localizer.
+    Resumes where a killed run stopped."""
+    from seannet.errors import NavigationError
+    from seannet.navigation.navigate import run_navigation
+    from seannet.navigation.tables import RATE_HEADER, rate_rows
 
+    if (navigator is None) == (not oracle):
+        raise NavigationError("give one of --navigator RUN and --oracle")
     with console.status("navigate") as status:
         result = run_navigation(
             runs, navigator, data, split=split, episodes=episodes, seed=seed, spacing=spacing,
-            epsilon=epsilon, out=out, maps=maps, strips=strips, progress=status.update,
+            epsilon=epsilon, replan=replan, workers=workers, out=out, maps=maps, strips=strips,
+            progress=status.update,
         )  # fmt: skip
-    table = Table(title=f"navigation on {split} of {data} ({episodes} episodes per case, room)")
-    for column in HEADER:
-        table.add_column(column, justify="right")
-    for row in table_rows(result):
-        table.add_row(*row)
-    console.print(table)
+    for rule in ("paper", "replan") if replan else ("paper",):
+        table = Table(title=f"{rule} rule, {split} of {data} ({episodes} episodes per case, room)")
+        for column in RATE_HEADER:
+            table.add_column(column, justify="right")
+        for row in rate_rows(result, rule):
+            table.add_row(*row)
+        console.print(table)
     console.print(f"wrote {result['written']} and its .json")
 
 

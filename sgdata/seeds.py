@@ -10,7 +10,8 @@ same stream by accident and a path never changes without this file changing::
                   └─ split_triplets_seed(split) ─ triplet_stream_seed(split, room, tier)
     training seed ─ init_seed() / epoch_order_seed(epoch) / epoch_dropout_seed(epoch)
     navigator seed ─ navigator_init_seed() / navigator_pairs_seed(split, room)
-                   └ navigator_order_seed(epoch)
+                   ├ navigator_order_seed(epoch)
+                   └ navigator_jitter_seed(epoch)
     navigation test seed ─ episode_seed(room, case, index)
     layout seed ─ appearance_seed()  (the layout's light and looks of its moving objects)
     texture_seed(kind, variant)  (procedural texture images: no dataset seed, shared by all)
@@ -39,6 +40,7 @@ __all__ = [
     "navigator_init_seed",
     "navigator_pairs_seed",
     "navigator_order_seed",
+    "navigator_jitter_seed",
     "episode_seed",
     "box_noise_seed",
     "room_look_seed",
@@ -49,6 +51,7 @@ __all__ = [
 _TRIPLETS = "triplets"  # the purpose key of triplet streams
 _INIT = 1 << 20  # the initial weights (epochs use 0, 1, 2, ...)
 _NAVIGATOR = "navigator"  # the purpose key of the visual navigator's streams
+_JITTER = "jitter"  # the navigator's light jitter, under _NAVIGATOR
 _EPISODES = "episodes"  # the purpose key of the navigation test's episodes
 _BOX_NOISE = "box noise"  # the purpose key of evaluation's labeler / detector noise
 _LOOKS = "looks"  # the purpose key of a room's base looks (texture variants)
@@ -142,6 +145,12 @@ def navigator_pairs_seed(training_seed: int, split: str, room_id: str) -> int:
 def navigator_order_seed(training_seed: int, epoch: int) -> int:
     """The seed of one navigator epoch's batch order."""
     return derive_seed(training_seed, name_key(_NAVIGATOR), epoch)
+
+
+def navigator_jitter_seed(training_seed: int, epoch: int) -> int:
+    """The seed of one navigator epoch's light jitter (its own stream: turning the jitter on
+    moves no batch order)."""
+    return derive_seed(training_seed, name_key(_NAVIGATOR), name_key(_JITTER), epoch)
 
 
 def episode_seed(test_seed: int, room_id: str, case: str, index: int) -> int:

@@ -8,17 +8,26 @@ move of one cell; after each step the localizer compares the current view with t
 sub-node's stored embedding and the robot stops when S > epsilon. At most ``k_max`` = 12
 steps per segment. Judged per step (:func:`step_verdict`), first failure ends the episode:
 
-- **collision**: a move into a cell off the layout's reachable grid;
-- **localization**: the robot stopped (S > epsilon) away from the goal, or stood on the goal
-  without stopping (it passes it);
+- **collision**: a move into a cell off the layout's reachable grid, classified
+  (:func:`collision_cause`) as *path blocked* (the planned next cell is not reachable in the
+  episode's layout: no navigator could pass) or *navigator error* (it was, and the navigator
+  took another action);
+- **localization**: the robot stopped (S > epsilon) away from the goal (a *false stop*), or
+  stood on the goal without stopping and passes it (a *missed goal*);
 - **navigation**: ``k_max`` steps without stopping and without a localization failure;
 - **success**: every segment stopped within half a cell and 10 degrees of its goal.
+
+Beyond the paper (``replan``): a real robot feels a bump. A collision then marks the
+segment's map edge unusable for the episode, the robot localizes itself on the map with the
+localizer (its best sub-node) and Dijkstra plans again from there; the episode ends on any
+other failure, when no path is left, or past a step budget (:func:`step_budget`).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+import time
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -28,21 +37,39 @@ from seannet.data.live_views import LiveRooms
 from seannet.errors import MapError, NavigationError
 from seannet.navigation.localizer import Localizer
 from seannet.navigation.maps import TopoMap
-from seannet.navigation.motion import HEADINGS, TURNS, apply, turn_towards
+from seannet.navigation.motion import (
+    HEADINGS,
+    NAVIGATOR_ACTIONS,
+    TURNS,
+    apply,
+    local_offset,
+    turn_towards,
+)
+from seannet.navigation.navigator import label_for
 
 __all__ = [
+    "BLOCKED",
     "CASES",
+    "CAUSES",
     "FAILURES",
     "K_MAX",
+    "LOCALIZATION_KINDS",
+    "NAVIGATOR_ERROR",
     "OUTCOMES",
     "Episode",
     "EpisodeResult",
     "Step",
+    "Timing",
+    "collision_cause",
+    "ideal_action",
     "judge_episode",
     "judge_segment",
+    "localization_kind",
     "reached",
     "run_episode",
     "sample_episode",
+    "segment_cells",
+    "step_budget",
     "step_verdict",
 ]
 
@@ -53,6 +80,13 @@ CASES = ("N", "A")  # neighbour sub-nodes / arbitrary sub-nodes
 FAILURES = ("navigation", "localization", "collision")
 OUTCOMES = ("success", *FAILURES)
 REACHED = "reached"  # a segment's goal reached and stopped at
+BLOCKED, NAVIGATOR_ERROR = "path blocked", "navigator error"  # why a collision happened
+CAUSES = (BLOCKED, NAVIGATOR_ERROR)
+FALSE_STOP, MISSED_GOAL = "false stop", "missed goal"  # the two localization failures
+LOCALIZATION_KINDS = (FALSE_STOP, MISSED_GOAL)
+# --replan: the episode's steps may reach this many times the paper's most (k_max per
+# segment of the first plan), so detours are possible but a robot bumping in circles stops
+REPLAN_BUDGET = 2
 
 Pose = tuple[int, int, int]
 
@@ -65,6 +99,7 @@ class Step:
     pose: Pose  # the true pose after it (for a collision: the blocked pose it tried)
     collided: bool = False
     similarity: float = float("nan")  # S(current view, goal sub-node); NaN after a collision
+    cause: str | None = None  # a collision's: BLOCKED or NAVIGATOR_ERROR
 
 
 def reached(pose: Pose, goal: Pose) -> bool:
@@ -82,6 +117,48 @@ def step_verdict(step: Step, goal: Pose, epsilon: float) -> str | None:
     if step.similarity > epsilon:
         return REACHED if here else "localization"  # stopped: at the goal, or a false positive
     return "localization" if here else None  # on the goal without stopping: it passes it
+
+
+def localization_kind(step: Step, goal: Pose, epsilon: float) -> str:
+    """Which localization failure ``step`` is: a false stop (S > epsilon away from the goal)
+    or a missed goal (on the goal, S <= epsilon)."""
+    return MISSED_GOAL if reached(step.pose, goal) and not step.similarity > epsilon else FALSE_STOP
+
+
+def segment_cells(start: Pose, goal: Pose) -> list[tuple[int, int]]:
+    """The cells of a translation edge's straight run, ``start``'s first, ``goal``'s last."""
+    (i1, j1), (i2, j2) = start[:2], goal[:2]
+    if i1 != i2 and j1 != j2:
+        raise NavigationError(f"{start} -> {goal}: not a straight map edge")
+    n = abs(i2 - i1) + abs(j2 - j1)
+    di, dj = (i2 > i1) - (i2 < i1), (j2 > j1) - (j2 < j1)
+    return [(i1 + k * di, j1 + k * dj) for k in range(n + 1)]
+
+
+def collision_cause(
+    pose: Pose, start: Pose, goal: Pose, reachable: Callable[[int, int], bool]
+) -> str:
+    """Why a move from ``pose`` collided in the translation segment ``start`` -> ``goal``.
+
+    :data:`BLOCKED` when the robot stood on the segment's run and the planned next cell of
+    the run is not reachable in the episode's layout (no navigator could pass); otherwise
+    :data:`NAVIGATOR_ERROR` (the planned cell was free, or the robot had left the run).
+    """
+    run = segment_cells(start, goal)
+    here = pose[:2]
+    if pose[2] != goal[2] or here not in run or here == run[-1]:
+        return NAVIGATOR_ERROR
+    return NAVIGATOR_ERROR if reachable(*run[run.index(here) + 1]) else BLOCKED
+
+
+def ideal_action(pose: Pose, goal: Pose) -> str:
+    """The navigator's right answer from ``pose`` towards ``goal`` (its label rule)."""
+    return NAVIGATOR_ACTIONS[label_for(*local_offset(pose, goal[:2]))]
+
+
+def step_budget(segments: int, k_max: int = K_MAX) -> int:
+    """The steps a ``--replan`` episode may take: twice the paper's most for its first plan."""
+    return REPLAN_BUDGET * k_max * segments
 
 
 def judge_segment(
@@ -124,17 +201,44 @@ class Episode:
 
 
 @dataclass
+class Timing:
+    """Seconds one episode spent rendering, embedding (localizer) and in the navigator."""
+
+    render: float = 0.0
+    embed: float = 0.0
+    navigator: float = 0.0
+
+    def timed(self, part: str, fn: Callable[..., Any], *args: Any) -> Any:
+        """``fn(*args)``, its wall time added to ``part``."""
+        started = time.perf_counter()
+        value = fn(*args)
+        setattr(self, part, getattr(self, part) + time.perf_counter() - started)
+        return value
+
+    def to_dict(self) -> dict[str, float]:
+        return {"render": self.render, "embed": self.embed, "navigator": self.navigator}
+
+
+@dataclass
 class EpisodeResult:
     """What happened in one episode."""
 
     episode: Episode
     outcome: str  # success | navigation | localization | collision
     failed_segment: int  # -1 on success
+    detail: str | None  # a collision's cause (CAUSES), a localization failure's kind
     segments: list[tuple[Pose, list[Step]]]
     frames: list[np.ndarray] = field(default_factory=list)  # views after each step (strips)
+    # (outcome, failed segment, detail) under the paper's rule: this run's own, or under
+    # --replan the first failure of the same run
+    paper: tuple[str, int, str | None] = ("success", -1, None)
+    replans: int = 0  # --replan: plans made again after a bump
+    timing: Timing = field(default_factory=Timing)
 
     def to_dict(self) -> dict[str, Any]:
+        """The episode as plain data; ``seconds`` is the only field that varies between runs."""
         e = self.episode
+        steps = [s for _, seg in self.segments for s in seg]
         return {
             "room_id": e.room_id,
             "case": e.case,
@@ -142,9 +246,15 @@ class EpisodeResult:
             "layout": e.layout,
             "path": [list(p) for p in e.path],
             "outcome": self.outcome,
+            "detail": self.detail,
             "failed_segment": self.failed_segment,
-            "steps": sum(len(s) for _, s in self.segments),
-            "actions": [[s.action for s in steps] for _, steps in self.segments],
+            "paper": dict(zip(("outcome", "failed_segment", "detail"), self.paper, strict=True)),
+            "steps": len(steps),
+            "replans": self.replans,
+            "bumps": [s.cause for s in steps if s.collided],
+            "goals": [list(goal) for goal, _ in self.segments],
+            "actions": [[s.action for s in seg] for _, seg in self.segments],
+            "seconds": self.timing.to_dict(),
         }
 
 
@@ -199,36 +309,107 @@ def run_episode(
     policy: Any,
     *,
     k_max: int = K_MAX,
+    replan: bool = False,
     keep_frames: bool = False,
 ) -> EpisodeResult:
-    """Run ``episode`` on the live renderer (see the module doc); ``policy.act(current,
-    goal)`` is the navigator (:class:`seannet.navigation.train_navigator.Policy`)."""
+    """Run ``episode`` on the live renderer (see the module doc).
+
+    Args:
+        policy: the navigator, ``policy.act(current, goal)`` on RGB views
+            (:class:`seannet.navigation.navigator.Policy`); None is the oracle, which takes
+            :func:`ideal_action` from the true pose (a bound that leaves only the localizer).
+        replan: bump and replan (beyond the paper) instead of ending on a collision.
+        keep_frames: keep every view (for strips).
+    """
     live.load(episode.room_id, episode.layout)
+    clock = Timing()
     pose = episode.path[0]
-    current = live.view(*pose)
+    current = clock.timed("render", live.view, *pose)
+    vector: np.ndarray | None = None  # the current view's embedding, once computed
     frames = [current.rgb] if keep_frames else []
+    plan = list(episode.path)
+    avoid: set[frozenset[tuple[int, int]]] = set()  # map edges found blocked
+    budget = step_budget(len(plan) - 1, k_max) if replan else math.inf
     segments: list[tuple[Pose, list[Step]]] = []
-    for a, b in zip(episode.path, episode.path[1:], strict=False):
-        goal_vector = topo.embedding(b)
-        goal_image = topo.image(b)
-        rotation = a[:2] == b[:2]
+    used = replans = n = 0
+    verdict: str | None = REACHED
+    while n < len(plan) - 1:
+        if used >= budget:  # --replan: the episode's steps are spent
+            verdict = None
+            break
+        a, b = plan[n], plan[n + 1]
+        goal_vector, goal_image = topo.embedding(b), topo.image(b)
         steps: list[Step] = []
         verdict = None
-        while verdict is None and len(steps) < k_max:
-            action = turn_towards(a[2], b[2]) if rotation else policy.act(current.rgb, goal_image)
+        while verdict is None and len(steps) < min(k_max, budget - used):
+            if a[:2] == b[:2]:
+                action = turn_towards(a[2], b[2])  # a rotation edge: the map's turn
+            elif policy is None:
+                action = ideal_action(pose, b)
+            else:
+                action = clock.timed("navigator", policy.act, current.rgb, goal_image)
             nxt = apply(pose, action)
             if action not in TURNS and not live.reachable(nxt[0], nxt[1]):
-                steps.append(Step(action, nxt, collided=True))
+                cause = collision_cause(pose, a, b, live.reachable)
+                steps.append(Step(action, nxt, collided=True, cause=cause))
             else:
                 pose = nxt
-                current = live.view(*pose)
-                vector = localizer.embed([live.tensors(current, localizer.transform)])[0]
+                current = clock.timed("render", live.view, *pose)
+                vector = clock.timed("embed", _embed, localizer, live, current)
                 steps.append(Step(action, pose, similarity=float(vector @ goal_vector)))
                 if keep_frames:
                     frames.append(current.rgb)
             verdict = step_verdict(steps[-1], b, localizer.epsilon)
+        used += len(steps)
         segments.append((b, steps))
-        if verdict != REACHED:
-            break
-    outcome, failed = judge_episode(segments, localizer.epsilon, k_max=k_max)
-    return EpisodeResult(episode, outcome, failed, segments, frames)
+        if verdict == REACHED:
+            n += 1
+            continue
+        if verdict == "collision" and replan and used < budget:
+            avoid.add(frozenset((a[:2], b[:2])))
+            if vector is None:  # bumped on the first move: the start view is not embedded yet
+                vector = clock.timed("embed", _embed, localizer, live, current)
+            here = topo.sub_nodes()[int(np.argmax(topo.embeddings @ vector))]
+            new = _replan(topo, here, plan[-1], avoid)
+            if new is not None:
+                plan, n, replans = new, 0, replans + 1
+                continue
+        break
+    # The paper's rule, a collision ends it: the first failure. Under --replan the steps
+    # before the first bump are the paper run's own (same views, same actions), so its
+    # paper-rule outcome is read off the same run.
+    paper = _ending(segments, *judge_episode(segments, localizer.epsilon, k_max=k_max), localizer)
+    ending = paper
+    if replan:
+        failed = len(segments) - 1
+        last = ("success", -1) if verdict == REACHED else (verdict or "navigation", failed)
+        ending = _ending(segments, *last, localizer)
+    return EpisodeResult(episode, *ending, segments, frames, paper, replans, clock)
+
+
+def _ending(
+    segments: list[tuple[Pose, list[Step]]], outcome: str, failed: int, localizer: Localizer
+) -> tuple[str, int, str | None]:
+    """(outcome, failed segment, detail): a collision's cause or a localization failure's kind."""
+    detail = None
+    if outcome in ("collision", "localization"):
+        goal, steps = segments[failed]
+        last = steps[-1]
+        detail = last.cause if last.collided else localization_kind(last, goal, localizer.epsilon)
+    return outcome, failed, detail
+
+
+def _embed(localizer: Localizer, live: LiveRooms, view: Any) -> np.ndarray:
+    return localizer.embed([live.tensors(view, localizer.transform)])[0]
+
+
+def _replan(
+    topo: TopoMap, here: Pose, goal: Pose, avoid: set[frozenset[tuple[int, int]]]
+) -> list[Pose] | None:
+    """Dijkstra's path from ``here`` to ``goal`` without the ``avoid`` edges; None when
+    there is none (or the robot believes it is at the goal already)."""
+    try:
+        path = topo.shortest_path(here, goal, avoid=avoid)
+    except MapError:
+        return None
+    return path if len(path) > 1 else None

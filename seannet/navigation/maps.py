@@ -49,6 +49,7 @@ __all__ = [
     "build_map",
     "build_maps",
     "check_map",
+    "current_map",
     "ensure_map",
     "load_map",
     "map_dirs",
@@ -160,15 +161,35 @@ class TopoMap:
             self._graph = g
         return self._graph
 
-    def shortest_path(self, start: SubNode, goal: SubNode) -> list[SubNode]:
+    def shortest_path(
+        self,
+        start: SubNode,
+        goal: SubNode,
+        *,
+        avoid: Iterable[frozenset[tuple[int, int]]] = (),
+    ) -> list[SubNode]:
         """Dijkstra's path from ``start`` to ``goal`` (both included).
+
+        Args:
+            avoid: translation edges, each the pair of its node cells, not to use (at any
+                heading): edges a robot found blocked.
 
         Raises:
             MapError: either is not a sub-node, or the goal cannot be reached.
         """
         self.index(start), self.index(goal)
+        graph = self.graph()
+        cut = [
+            ((*a, h), (*b, h))
+            for pair in avoid
+            for a, b in [sorted(pair)]
+            for h in range(HEADINGS)
+            if graph.has_edge((*a, h), (*b, h))
+        ]
+        if cut:
+            graph = nx.restricted_view(graph, [], cut)
         try:
-            return list(nx.dijkstra_path(self.graph(), tuple(start), tuple(goal), weight="cost"))
+            return list(nx.dijkstra_path(graph, tuple(start), tuple(goal), weight="cost"))
         except nx.NetworkXNoPath:
             raise MapError(f"map of {self.room_id}: no path from {start} to {goal}") from None
 
@@ -301,6 +322,21 @@ def check_map(topo: TopoMap, localizer: Localizer, where: Path) -> None:
         raise MapError(f"{path}: dataset differs from the run's; use the map's dataset")
 
 
+def current_map(
+    localizer: Localizer, room_id: str, directory: Path, *, layout: int = 0, spacing: int = 2
+) -> TopoMap | None:
+    """The map in ``directory`` if this run built it for ``room_id`` with these parameters;
+    None when it is missing, stale or damaged (then it is to be built again)."""
+    if not (directory / MAP_META).is_file():
+        return None
+    try:
+        topo = load_map(directory)
+        check_map(topo, localizer, directory)
+    except MapError:
+        return None
+    return topo if (topo.room_id, topo.layout, topo.spacing) == (room_id, layout, spacing) else None
+
+
 def ensure_map(
     localizer: Localizer,
     live: LiveRooms,
@@ -312,14 +348,9 @@ def ensure_map(
 ) -> TopoMap:
     """The map in ``directory`` if it was built by this run with these parameters, else a new
     one built and saved there."""
-    if (directory / MAP_META).is_file():
-        try:
-            topo = load_map(directory)
-            check_map(topo, localizer, directory)
-            if (topo.room_id, topo.layout, topo.spacing) == (room_id, layout, spacing):
-                return topo
-        except MapError:
-            pass  # stale or damaged: rebuilt below
+    topo = current_map(localizer, room_id, directory, layout=layout, spacing=spacing)
+    if topo is not None:
+        return topo
     topo = build_map(localizer, live, room_id, layout=layout, spacing=spacing)
     save_map(topo, directory)
     return topo

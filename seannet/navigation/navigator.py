@@ -2,8 +2,9 @@
 
 The network and what it learns from: its config, the label rule and the draw of a training
 pair (the authors: goal within +-2 cells sideways and 0..4 cells forward of the current pose,
-same heading; the label is the larger displacement). Rendering pairs and training are in
-:mod:`seannet.navigation.train_navigator`; :class:`Policy` acts with a trained one.
+same heading; the label is the larger displacement). Rendering pairs is in
+:mod:`seannet.navigation.pairs`, training in :mod:`seannet.navigation.train_navigator`;
+:class:`Policy` acts with a trained one.
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ from seannet.errors import CheckpointError, ModelError
 from seannet.model.backbones import ENCODER_NAMES, image_encoder
 from seannet.navigation.motion import FORWARD, HEADINGS, NAVIGATOR_ACTIONS, local_offset
 from seannet.training.runs import BEST, device_for_run, load_checkpoint
-from seannet.weights import IMAGENET_MEAN, IMAGENET_STD
+from seannet.weights import normalisation
 
 __all__ = [
     "KIND",
@@ -45,10 +46,11 @@ def resize(rgb: np.ndarray, size: int) -> np.ndarray:
     return ImageTransform(size).resize(rgb, _NO_BOXES)[0]
 
 
-def navigator_inputs(images: np.ndarray) -> Tensor:
-    """(B, S, S, 3) uint8 -> (B, 3, S, S) float32 normalised as every ImageNet network's."""
+def navigator_inputs(images: np.ndarray, encoder: str = "resnet18") -> Tensor:
+    """(B, S, S, 3) uint8 -> (B, 3, S, S) float32 normalised as ``encoder``'s ImageNet
+    weights saw their pixels (EfficientNet-Lite0's differ from torchvision's)."""
     pixels = torch.from_numpy(np.array(images, dtype=np.uint8)).permute(0, 3, 1, 2)
-    return normalise_pixels(pixels, IMAGENET_MEAN, IMAGENET_STD)
+    return normalise_pixels(pixels, *normalisation(encoder))
 
 
 _NO_BOXES = np.zeros((0, 4), dtype=np.float32)
@@ -69,6 +71,11 @@ class NavigatorConfig:
     val_pairs: int = 400  # from the val rooms: accuracy every epoch picks best.pt
     max_side: int = 2  # goal within +-max_side cells sideways ...
     max_forward: int = 4  # ... and 0..max_forward cells forward
+    # What the test changes: its goal is the map's view of layout 0 while the robot walks in
+    # another layout (moved objects, their looks, the light). Share of pairs whose goal view
+    # is rendered in another layout of the room than the current view (train and val alike):
+    cross_layout: float = 0.0
+    jitter: float = 0.0  # train-time brightness and contrast jitter, +- this share, per view
     seed: int = 0
 
     def __post_init__(self) -> None:
@@ -85,6 +92,11 @@ class NavigatorConfig:
             raise ModelError("navigator: val_pairs, max_side and max_forward must be >= 0")
         if self.max_side + self.max_forward < 1:
             raise ModelError("navigator: max_side + max_forward must be >= 1 (a goal must move)")
+        if not 0 <= self.cross_layout <= 1 or not 0 <= self.jitter < 1:
+            raise ModelError(
+                f"navigator: cross_layout {self.cross_layout} must be within [0, 1], "
+                f"jitter {self.jitter} within [0, 1)"
+            )
         if self.lr <= 0 or not 0 <= self.momentum < 1:
             raise ModelError(f"navigator: lr {self.lr} must be > 0, momentum within [0, 1)")
 
@@ -191,8 +203,9 @@ class Policy:
     def act(self, current: np.ndarray, goal: np.ndarray) -> str:
         """The action (forward / left / right) from (H, W, 3) uint8 current and goal views."""
         s = self.config.image_size
-        a = navigator_inputs(resize(current, s)[None]).to(self.device)
-        b = navigator_inputs(resize(goal, s)[None]).to(self.device)
+        encoder = self.config.encoder
+        a = navigator_inputs(resize(current, s)[None], encoder).to(self.device)
+        b = navigator_inputs(resize(goal, s)[None], encoder).to(self.device)
         return NAVIGATOR_ACTIONS[int(self.model(a, b).argmax(1)[0])]
 
 

@@ -39,6 +39,7 @@ SEANNET_MAY_IMPORT = (
     "sgdata.lazy_face",
     "sgdata.annotate.relations",  # the relation types: the dataset's own vocabulary
     "sgdata.world.catalog",  # the class vocabulary when a model is built without a dataset
+    "sgdata.pipeline.executors",  # spawned workers that die with their parent (navigate)
 )
 LIVE_VIEWS_MAY_IMPORT = ("sgdata.render", "sgdata.usd", "sgdata.annotate", "sgdata.world.poses")
 HEAVY = ("pxr", "pyrender", "open3d", "trimesh", "torch", "OpenGL", "sgdata.render", "sgdata.usd")

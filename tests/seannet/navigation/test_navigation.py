@@ -3,8 +3,13 @@ and a short end-to-end run on the mini dataset that writes Table II."""
 
 from __future__ import annotations
 
-import json
+import os
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -13,6 +18,7 @@ import torch
 from seannet.data.live_views import LiveRooms
 from seannet.errors import ModelError, NavigationError
 from seannet.navigation.episodes import (
+    OUTCOMES,
     Step,
     judge_episode,
     judge_segment,
@@ -30,7 +36,7 @@ from seannet.navigation.navigator import (
     label_for,
     load_navigator,
 )
-from seannet.navigation.train_navigator import train_navigator
+from seannet.navigation.tables import case_rates, read_results
 from sgdata.seeds import episode_seed, rng_for
 
 EPS = 0.9
@@ -103,38 +109,53 @@ def test_every_outcome_from_hand_made_trajectories() -> None:
         judge_segment(GOAL, [on_the_way], EPS)
 
 
+def _without_times(results: dict) -> list:
+    """Every run's episodes without their wall times (the one field that varies)."""
+    return [
+        [{k: v for k, v in e.items() if k != "seconds"} for e in run["episodes"]]
+        for run in results["runs"]
+    ]
+
+
 def test_navigate_end_to_end_writes_table_two(
-    localizer_run: Path, mini_dataset: Path, tmp_path: Path
+    navigation_run: SimpleNamespace, localizer_run: Path, mini_dataset: Path, tmp_path: Path, procs
 ) -> None:
-    config = NavigatorConfig(
-        image_size=64, hidden=16, epochs=1, batch_size=8, train_pairs=8, val_pairs=4
-    )
-    history = train_navigator(config, mini_dataset, tmp_path / "nav")
-    assert len(history) == 1 and (tmp_path / "nav" / "best.pt").is_file()
-    assert load_navigator(tmp_path / "nav").act(
+    nav, out = navigation_run.navigator, navigation_run.out
+    assert len(navigation_run.history) == 1 and (nav / "best.pt").is_file()
+    assert load_navigator(nav).act(
         np.zeros((96, 96, 3), np.uint8), np.zeros((96, 96, 3), np.uint8)
     ) in ("forward", "left", "right")
-    run_navigation(
-        [localizer_run],
-        tmp_path / "nav",
-        mini_dataset,
-        episodes=2,
-        epsilon=0.95,
-        out=tmp_path / "out",
-        strips=tmp_path / "strips",
-    )
-    written = json.loads((tmp_path / "out" / "navigate_test.json").read_text())
+    written = read_results(out / "navigate_test.json")
+    assert "seconds" not in (out / "navigate_test.json").read_text()
     (run,) = written["runs"]
-    for case in ("N", "A"):
-        row = run["table"][case]
-        assert row["total"] == 2  # one test room, two episodes per case
-        assert sum(row[k] for k in ("success", "navigation", "localization", "collision")) == (
-            pytest.approx(100.0)
-        )
-    assert "| localizer |" in (tmp_path / "out" / "navigate_test.md").read_text()
-    assert list((tmp_path / "strips" / localizer_run.name).glob("*.png"))
+    for rule in ("paper", "replan"):
+        table = case_rates(run["episodes"], rule)
+        for case in ("N", "A"):
+            row = table[case]
+            assert row["total"] == 2  # one test room, two episodes per case
+            assert sum(row[k]["percent"] for k in OUTCOMES) == pytest.approx(100.0)
+            # every collision has a cause, every localization failure a kind
+            assert (
+                row["path blocked"]["count"] + row["navigator error"]["count"]
+                == (row["collision"]["count"])
+            )
+            assert (
+                row["false stop"]["count"] + row["missed goal"]["count"]
+                == (row["localization"]["count"])
+            )
+            assert row["success"]["low"] <= row["success"]["percent"] <= row["success"]["high"]
+    text = (out / "navigate_test.md").read_text()
+    assert "The paper's rule" in text and "Bump and replan" in text and "render s" in text
+    assert all(e["seconds"]["total"] > 0 for e in run["episodes"])
+    # a strip of the first episode of each outcome and kind, per room and case
+    expected = {}
+    for e in run["episodes"]:
+        kind = "_".join(str(k).replace(" ", "-") for k in (e["outcome"], e["detail"]) if k)
+        expected.setdefault((e["room_id"], e["case"], kind), e["index"])
+    strips = {p.stem for p in (navigation_run.strips / localizer_run.name).glob("*.png")}
+    assert strips == {f"{r}_{c}_{i}_{k}" for (r, c, k), i in expected.items()}
     # reproducible: the episodes are drawn again from their seeds, with the same paths
-    (room_dir,) = (tmp_path / "out" / "maps" / localizer_run.name).iterdir()
+    (room_dir,) = (out / "maps" / localizer_run.name).iterdir()
     topo = load_map(room_dir)
     with LiveRooms(mini_dataset) as live:
         for record in run["episodes"]:
@@ -144,3 +165,45 @@ def test_navigate_end_to_end_writes_table_two(
             assert episode.layout == record["layout"] != topo.layout
             if record["case"] == "N":
                 assert len(episode.path) == 2
+
+    # killed (SIGKILL, its workers go with it) after its first part, then resumed: the same
+    # episodes, byte for byte but for wall times, as the uninterrupted run with two workers
+    killed = tmp_path / "killed"
+    command = [
+        sys.executable, "-m", "sgdata_cli.seannet_app", "navigate", str(localizer_run),
+        "--navigator", str(nav), "--data", str(mini_dataset), "--episodes", "2",
+        "--epsilon", "0.95", "--replan", "--workers", "1", "--out", str(killed),
+        "--maps", str(out / "maps"),
+    ]  # fmt: skip
+    process = subprocess.Popen(
+        command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True
+    )
+    deadline = time.monotonic() + 300
+    while not list((killed / "parts").glob("*/*.json")):
+        assert process.poll() is None, process.stderr.read().decode() if process.stderr else ""
+        assert time.monotonic() < deadline, "no part finished in time"
+        time.sleep(0.05)
+    os.kill(process.pid, signal.SIGKILL)
+    process.wait()
+    assert procs.wait_until_gone(lambda: procs.in_session(process.pid)) == []
+    (first,) = list((killed / "parts").glob("*/*.json"))
+    stamp = first.stat().st_mtime_ns
+    assert not (killed / "navigate_test.json").exists()
+    resumed = run_navigation(
+        [localizer_run], nav, mini_dataset, workers=1, out=killed, maps=out / "maps",
+        **navigation_run.options,
+    )  # fmt: skip
+    assert first.stat().st_mtime_ns == stamp  # the finished part was not run again
+    assert _without_times(resumed) == _without_times(written)
+    # the results file itself: the same bytes (wall times live beside it)
+    assert (killed / "navigate_test.json").read_bytes() == (out / "navigate_test.json").read_bytes()
+
+
+def test_navigate_wants_a_navigator_or_the_oracle(localizer_run: Path, mini_dataset: Path) -> None:
+    command = [sys.executable, "-m", "sgdata_cli.seannet_app", "navigate", str(localizer_run)]
+    result = subprocess.run(
+        [*command, "--data", str(mini_dataset)], capture_output=True, text=True, timeout=300
+    )
+    assert result.returncode != 0 and "Traceback" not in result.stderr
+    (line,) = result.stderr.strip().splitlines()
+    assert "--navigator RUN" in line and "--oracle" in line

@@ -1,0 +1,63 @@
+"""bench/navigation.py writes docs/navigation.md's tables from runs: here from the tiny ones."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import shutil
+from pathlib import Path
+from types import ModuleType, SimpleNamespace
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[3]
+DOC = """# Navigation
+
+<!-- bench/navigation.py: paper -->
+typed by hand
+<!-- end paper -->
+
+prose that stays
+
+<!-- bench/navigation.py: measured -->
+<!-- end measured -->
+"""
+
+
+def _bench() -> ModuleType:
+    spec = importlib.util.spec_from_file_location("bench_navigation", ROOT / "bench/navigation.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_tables_from_tiny_runs(
+    navigation_run: SimpleNamespace, mini_dataset: Path, tmp_path: Path
+) -> None:
+    bench = _bench()
+    out = tmp_path / "bench"
+    shutil.copytree(navigation_run.navigator, out / "navigator")
+    (out / "navigate").mkdir()
+    for name in ("navigate_test.json", "navigate_test_times.json"):
+        shutil.copy(navigation_run.out / name, out / "navigate")
+    made = bench.provenance(mini_dataset, ["bench/navigation.py", "run", "tiny"])
+    (out / bench.PROVENANCE).write_text(json.dumps(made))
+    doc = tmp_path / "navigation.md"
+    doc.write_text(DOC)
+    bench.write_tables(out, doc)
+    text = doc.read_text()
+    assert "typed by hand" not in text and "prose that stays" in text
+    assert "| paper, SeanNet | 5,476 / 204,136 | 80.2 / 65.2 | 2.4 / 6.2 | 13.2 / 21.7 |" in text
+    assert made["commit"][:12] in text and made["manifest_sha256"][:16] in text
+    results = navigation_run.results
+    (run,) = results["runs"]
+    label = f"| {run['model']} ({run['label']}) | 2 / 2 |"
+    assert text.count(label) == 2  # the paper rule's table and --replan's
+    assert "Bump and replan" in text and "path blocked % N / A" in text
+    assert "Time per episode" in text and "Val accuracy by action" in text
+    bench.write_tables(out, doc)
+    assert doc.read_text() == text  # the same runs, the same document
+    doc.write_text("# no blocks\n")
+    with pytest.raises(SystemExit, match="no block"):
+        bench.write_tables(None, doc)
