@@ -97,12 +97,15 @@ def run(args: argparse.Namespace) -> None:
             raise SystemExit(f"unknown step {step!r}: headline, noise or ablations")
 
 
-def noise_step(data: Path, runs: Path) -> None:
+def noise_step(
+    data: Path, runs: Path, grid: tuple[tuple[float, float], ...] = NOISE_GRID
+) -> None:
+    """The headline models' runs on test under each (S, P) of ``grid``."""
     selection = json.loads((runs / "selection-headline.json").read_text())
     chosen = {m["model"]: m["runs"] for m in selection["models"]}
     for model in NOISE_MODELS:
         boxes = model.endswith("+boxes")
-        for jitter, drop in NOISE_GRID:
+        for jitter, drop in grid:
             noise = BoxNoise(jitter=jitter, drop=drop)
             seeds = chosen[model] if (jitter, drop) == AIM else chosen[model][:1]
             for run_dir in map(Path, seeds):
