@@ -97,9 +97,7 @@ def run(args: argparse.Namespace) -> None:
             raise SystemExit(f"unknown step {step!r}: headline, noise or ablations")
 
 
-def noise_step(
-    data: Path, runs: Path, grid: tuple[tuple[float, float], ...] = NOISE_GRID
-) -> None:
+def noise_step(data: Path, runs: Path, grid: tuple[tuple[float, float], ...] = NOISE_GRID) -> None:
     """The headline models' runs on test under each (S, P) of ``grid``."""
     selection = json.loads((runs / "selection-headline.json").read_text())
     chosen = {m["model"]: m["runs"] for m in selection["models"]}
