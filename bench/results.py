@@ -130,6 +130,12 @@ def _span(entry: dict[str, float], sign: bool = False) -> str:
     return f"{f(entry['mean'])} [{f(entry['low'])}, {f(entry['high'])}]"
 
 
+def _budget(seconds: float | None) -> str:
+    if seconds is None:
+        return "the preset's batches per epoch for every model"
+    return f"{seconds:g} s of training per run (batches per epoch from each network's timed steps)"
+
+
 def _stamp(record: dict[str, Any]) -> str:
     dirty = " (with uncommitted changes)" if record["dirty"] else ""
     return (
@@ -142,8 +148,8 @@ def _stamp(record: dict[str, Any]) -> str:
 
 def _comparison_tables(result: dict[str, Any]) -> list[str]:
     lines = [
-        f"Preset `{result['preset']}`, {result['budget_s']:g} s of training per run (batches "
-        "per epoch from each network's timed steps), learning rate of each model chosen on "
+        f"Preset `{result['preset']}`, {_budget(result['budget_s'])}, learning rate of each "
+        "model chosen on "
         f"the whole val split from {result['lrs']} with seed {result['seeds'][0]}, then seeds "
         f"{result['seeds']} at it; test read once, after `selection.json` was written.",
         "",

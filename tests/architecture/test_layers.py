@@ -46,9 +46,19 @@ HEAVY = ("pxr", "pyrender", "open3d", "trimesh", "torch", "OpenGL", "sgdata.rend
 
 
 def _imports(path: Path, package: str = "sgdata") -> set[str]:
-    """Every ``package`` module a file imports, at module level or inside functions."""
+    """Every ``package`` module a file imports, at module level or inside functions (not
+    under ``if TYPE_CHECKING:``: an annotation's import never runs)."""
     found = set()
-    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    typing_only = {
+        id(n)
+        for block in ast.walk(tree)
+        if isinstance(block, ast.If) and ast.unparse(block.test).endswith("TYPE_CHECKING")
+        for n in ast.walk(block)
+    }
+    for node in ast.walk(tree):
+        if id(node) in typing_only:
+            continue
         if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
             found.add(node.module)
         elif isinstance(node, ast.Import):
