@@ -7,7 +7,7 @@ than three corners are fanned into triangles; ``primvars:displayColor`` gives th
 (constant, uniform, vertex and faceVarying interpolation; grey when absent). Bound materials
 override it where they say more (:mod:`sgdata.usd.bound_materials`): a textured face carries
 its texture file and coordinates, and the texture's colour factor as its face colour. The
-stage's light (``sgdata:light:*`` on its room prim, :mod:`sgdata.usd.looks`) comes back as
+stage's light (``sgdata:light:*`` on its room prim, :mod:`sgdata.usd.prims`) comes back as
 :class:`~sgdata.usd.meshes.Lighting`.
 """
 
@@ -21,9 +21,9 @@ from pxr import Usd, UsdGeom
 
 from sgdata.usd.bound_materials import MaterialReader
 from sgdata.usd.gprims import tessellate_gprim
-from sgdata.usd.looks import LIGHT_INTENSITY, LIGHT_TEMPERATURE
 from sgdata.usd.meshes import Lighting, MeshData, ObjectGeometry, SceneGeometry, merge_meshes
 from sgdata.usd.object_prims import drawn_prims, instance_ids, is_object
+from sgdata.usd.prims import LIGHT_INTENSITY, LIGHT_TEMPERATURE
 from sgdata.usd.stage import open_stage
 from sgdata.usd.stage_frame import room_prim, stage_frame
 from sgdata.world.appearance import light_color

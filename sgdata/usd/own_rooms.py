@@ -29,7 +29,8 @@ from pxr import Usd
 from sgdata.errors import UsdError
 from sgdata.usd.geometry import stage_geometry
 from sgdata.usd.meshes import MeshData, ObjectGeometry
-from sgdata.usd.stage_frame import ROOM_ORIGIN, room_prim
+from sgdata.usd.prims import ROOM_ORIGIN
+from sgdata.usd.stage_frame import room_prim
 from sgdata.world.catalog import Catalog, load_catalog
 from sgdata.world.scene import WALLS, Dynamics, Opening, Placement, Room, SceneObject
 

@@ -11,12 +11,12 @@ up-corrected axes) is the point that becomes the room frame's origin; ``sgdata t
 from __future__ import annotations
 
 import numpy as np
-from pxr import Sdf, Usd, UsdGeom
+from pxr import Usd, UsdGeom
 
-__all__ = ["ROOM_ORIGIN", "room_prim", "stage_frame", "up_and_units"]
+from sgdata.usd.prims import ROOM_ORIGIN, ROOT
 
-ROOM_ORIGIN = "sgdata:roomOrigin"
-_ROOM = Sdf.Path("/Room")
+__all__ = ["room_prim", "stage_frame", "up_and_units"]
+
 
 # stage axes -> Z-up axes: a Y-up stage's +Y becomes +Z, its +Z becomes -Y (a +90 degree turn
 # about X), so right-handed frames stay right-handed
@@ -25,7 +25,7 @@ _Y_UP = np.array([[1.0, 0, 0, 0], [0, 0, -1.0, 0], [0, 1.0, 0, 0], [0, 0, 0, 1.0
 
 def room_prim(stage: Usd.Stage) -> Usd.Prim:
     """The room prim: ``/Room`` when present, else the stage's default prim (maybe invalid)."""
-    prim = stage.GetPrimAtPath(_ROOM)
+    prim = stage.GetPrimAtPath(ROOT)
     if prim.IsValid():
         return prim
     return stage.GetDefaultPrim()
