@@ -15,7 +15,7 @@ from pxr import Usd, UsdGeom
 
 from sgdata.usd.prims import ROOM_ORIGIN, ROOT
 
-__all__ = ["room_prim", "stage_frame", "up_and_units"]
+__all__ = ["meters_per_unit", "room_prim", "stage_frame", "up_and_units"]
 
 
 # stage axes -> Z-up axes: a Y-up stage's +Y becomes +Z, its +Z becomes -Y (a +90 degree turn
@@ -31,11 +31,16 @@ def room_prim(stage: Usd.Stage) -> Usd.Prim:
     return stage.GetDefaultPrim()
 
 
-def up_and_units(stage: Usd.Stage) -> np.ndarray:
-    """The 4x4 transform (column convention) turning stage axes and units into Z-up metres."""
+def meters_per_unit(stage: Usd.Stage) -> float:
+    """The stage's ``metersPerUnit`` as sgdata reads it: 1 when the stage does not author one."""
     # USD's fallback is centimetres; sgdata has always read stages without the field as metres
     has_units = UsdGeom.StageHasAuthoredMetersPerUnit(stage)
-    scale = float(UsdGeom.GetStageMetersPerUnit(stage)) if has_units else 1.0
+    return float(UsdGeom.GetStageMetersPerUnit(stage)) if has_units else 1.0
+
+
+def up_and_units(stage: Usd.Stage) -> np.ndarray:
+    """The 4x4 transform (column convention) turning stage axes and units into Z-up metres."""
+    scale = meters_per_unit(stage)
     m = np.diag([scale, scale, scale, 1.0])
     if UsdGeom.GetStageUpAxis(stage) == UsdGeom.Tokens.y:
         m = _Y_UP @ m

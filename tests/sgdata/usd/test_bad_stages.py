@@ -1,0 +1,63 @@
+"""Malformed meshes, gprims and transforms in a stage: one-line UsdErrors naming the prim."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from pxr import Gf, Usd, UsdGeom
+
+from sgdata.errors import UsdError
+from sgdata.usd.geometry import read_geometry
+
+from .user_stages import write_user_room
+
+TOP = "/Room/Things/Table/Top"
+
+
+def mutated(tmp_path: Path, change: str) -> Path:
+    path = write_user_room(tmp_path / "room.usda")
+    stage = Usd.Stage.Open(str(path))
+    mesh = UsdGeom.Mesh(stage.GetPrimAtPath(TOP))
+    if change == "inf point":
+        points = list(mesh.GetPointsAttr().Get())
+        points[0] = Gf.Vec3f(float("inf"), 0, 0)
+        mesh.GetPointsAttr().Set(points)
+    elif change == "negative index":
+        indices = list(mesh.GetFaceVertexIndicesAttr().Get())
+        indices[2] = -1
+        mesh.GetFaceVertexIndicesAttr().Set(indices)
+    elif change == "counts disagree":
+        mesh.GetFaceVertexCountsAttr().Set([4] * 7)
+    elif change == "zero scale":
+        UsdGeom.Xformable(stage.GetPrimAtPath("/Room/Things/Table")).AddScaleOp().Set(
+            Gf.Vec3f(1, 0, 1)
+        )
+    elif change == "negative radius":
+        UsdGeom.Cylinder.Define(stage, "/Room/Mug/Body").GetRadiusAttr().Set(-0.04)
+    elif change == "nan translate":
+        UsdGeom.Xformable(stage.GetPrimAtPath("/Room/Mug")).GetOrderedXformOps()[0].Set(
+            Gf.Vec3d(float("nan"), 0, 0)
+        )
+    stage.GetRootLayer().Save()
+    return path
+
+
+CASES = {
+    "inf point": f"{TOP} points[0] is (inf, ",
+    "negative index": f"{TOP} faceVertexIndices[2] is -1, past the mesh's 8 points",
+    "counts disagree": f"{TOP} faceVertexCounts sum to 28 but faceVertexIndices holds 24",
+    "zero scale": "/Room/Things/Table has a singular transform",
+    "negative radius": "/Room/Mug/Body.radius is -0.04; expected a positive finite number",
+    "nan translate": "/Room/Mug/Body has a transform with NaN or infinite values",
+}
+
+
+@pytest.mark.parametrize("change", sorted(CASES))
+def test_a_malformed_prim_is_named_in_one_line(tmp_path: Path, change: str) -> None:
+    path = mutated(tmp_path, change)
+    with pytest.raises(UsdError) as raised:
+        read_geometry(path)
+    message = str(raised.value)
+    assert message.startswith(f"{path}: ") and "\n" not in message
+    assert CASES[change] in message
