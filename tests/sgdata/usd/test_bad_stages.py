@@ -9,6 +9,8 @@ from pxr import Gf, Usd, UsdGeom
 
 from sgdata.errors import UsdError
 from sgdata.usd.geometry import read_geometry
+from sgdata.usd.own_rooms import measure_stage
+from sgdata.usd.stage import open_stage
 
 from .user_stages import write_user_room
 
@@ -61,3 +63,20 @@ def test_a_malformed_prim_is_named_in_one_line(tmp_path: Path, change: str) -> N
     message = str(raised.value)
     assert message.startswith(f"{path}: ") and "\n" not in message
     assert CASES[change] in message
+
+
+def test_supports_in_a_circle_are_refused(tmp_path: Path) -> None:
+    # accepted before, then sampling layouts hung, growing memory (found by tests/fuzz)
+    path = write_user_room(tmp_path / "room.usda")
+    stage = Usd.Stage.Open(str(path))
+    table, mug = stage.GetPrimAtPath("/Room/Things/Table"), stage.GetPrimAtPath("/Room/Mug")
+    table.CreateRelationship("sgdata:support").SetTargets([mug.GetPath()])
+    mug.CreateRelationship("sgdata:support").SetTargets([table.GetPath()])
+    stage.GetRootLayer().Save()
+    with pytest.raises(UsdError) as raised:
+        measure_stage(open_stage(path), path)
+    assert str(raised.value) == (
+        f"{path}: /Room/Things/Table -> /Room/Mug -> /Room/Things/Table: sgdata:support goes "
+        "round in a circle; expected every chain to end at an object on the floor or a wall: "
+        "remove sgdata:support from one of them"
+    )
