@@ -32,6 +32,7 @@ _EXPORTS = {
     "check_stage": ".stage",
     "open_layer": ".stage",
     "open_stage": ".stage",
+    "usd_reason": ".stage",
     "validate_stage": ".stage",
     "write_text_atomic": ".stage",
     "DEFAULT_COLOR": ".geometry",

@@ -17,7 +17,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
-from pxr import Usd, UsdGeom
+from pxr import Tf, Usd, UsdGeom
 
 from sgdata.errors import UsdError
 from sgdata.usd.bound_materials import MaterialReader
@@ -25,7 +25,7 @@ from sgdata.usd.gprims import tessellate_gprim
 from sgdata.usd.meshes import Lighting, MeshData, ObjectGeometry, SceneGeometry, merge_meshes
 from sgdata.usd.object_prims import drawn_prims, instance_ids, is_object
 from sgdata.usd.prims import LIGHT_INTENSITY, LIGHT_TEMPERATURE
-from sgdata.usd.stage import open_stage
+from sgdata.usd.stage import open_stage, usd_reason
 from sgdata.usd.stage_frame import room_prim, stage_frame
 from sgdata.world.appearance import light_color
 from sgdata.world.scene import transform_points
@@ -67,12 +67,16 @@ def stage_geometry(stage: Usd.Stage, path: Path) -> SceneGeometry:
             owners[str(prim.GetPath())] = prim
             parts.setdefault(str(prim.GetPath()), [])
         try:
+            _check_value_types(prim)
             found = _prim_triangles(prim, materials)
         except UsdError as exc:
             raise UsdError(f"{path}: {exc}") from None
         if found is None:
             continue
-        world = _world(cache, prim, frame)
+        try:
+            world = _world(cache, prim, frame)
+        except UsdError as exc:
+            raise UsdError(f"{path}: {exc}") from None
         owner = _owner(prim, owners)
         if not np.isfinite(world).all():
             raise UsdError(
@@ -147,8 +151,12 @@ def _owner(prim: Usd.Prim, owners: dict[str, Usd.Prim]) -> Usd.Prim | None:
 
 
 def _world(cache: UsdGeom.XformCache, prim: Usd.Prim, frame: np.ndarray | None) -> np.ndarray:
-    # USD matrices act on row vectors (p' = p M): transpose for the column convention
-    m = np.array(cache.GetLocalToWorldTransform(prim), dtype=np.float64).T
+    try:
+        # USD matrices act on row vectors (p' = p M): transpose for the column convention
+        m = np.array(cache.GetLocalToWorldTransform(prim), dtype=np.float64).T
+    except Tf.ErrorException as exc:  # e.g. an xformOp authored with the wrong value type
+        reason = usd_reason(exc)
+        raise UsdError(f"{prim.GetPath()}: USD cannot compute its transform ({reason})") from None
     return m if frame is None else frame @ m
 
 
@@ -220,6 +228,28 @@ def _triangles(mesh: UsdGeom.Mesh, materials: MaterialReader) -> MeshData:
         face_texture=bound.face_texture if textured else None,
         textures=bound.files if textured else (),
     )
+
+
+# Python types of scalar values (pxr gives no pythonClass for them)
+_SCALARS = {"double": float, "float": float, "half": float, "int": int, "int64": int,
+            "uint": int, "token": str, "string": str, "bool": bool}  # fmt: skip
+
+
+def _check_value_types(prim: Usd.Prim) -> None:
+    """Refuse an attribute authored with another value type than its schema's (a wrong
+    typeName in a hand-written file: ``string points = "1"``) rather than misread it."""
+    for attr in prim.GetAuthoredAttributes():
+        value = attr.Get()
+        name = attr.GetTypeName()
+        expected = name.type.pythonClass or _SCALARS.get(str(name))
+        if value is None or expected is None or isinstance(value, expected):
+            continue
+        if expected is float and isinstance(value, int):
+            continue
+        shown = repr(value) if len(repr(value)) < 40 else repr(value)[:37] + "..."
+        raise UsdError(
+            f"{attr.GetPath()} holds {shown}, authored with another value type; expected {name}"
+        )
 
 
 def _display_color(mesh: UsdGeom.Gprim) -> tuple[np.ndarray, str] | None:

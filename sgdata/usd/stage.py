@@ -16,7 +16,14 @@ from pxr import Sdf, Tf, Usd, UsdValidation
 from sgdata.errors import UsdError
 from sgdata.fileio import atomic_write_text
 
-__all__ = ["open_layer", "open_stage", "write_text_atomic", "validate_stage", "check_stage"]
+__all__ = [
+    "open_layer",
+    "open_stage",
+    "write_text_atomic",
+    "validate_stage",
+    "check_stage",
+    "usd_reason",
+]
 
 
 def write_text_atomic(path: Path, text: str) -> None:
@@ -51,7 +58,7 @@ def open_layer(path: Path, what: str | None = None) -> Sdf.Layer:
         else:
             layer = Sdf.Layer.FindOrOpen(str(path))
     except Tf.ErrorException as exc:
-        raise UsdError(f"{what}: unreadable USD layer ({_tf_message(exc)})") from None
+        raise UsdError(f"{what}: unreadable USD layer ({usd_reason(exc)})") from None
     if layer is None:
         raise UsdError(f"{what}: unreadable USD layer")
     return layer
@@ -85,7 +92,7 @@ def open_stage(path: Path, *, strict: bool = True) -> Usd.Stage:
     try:
         stage = Usd.Stage.Open(layer)
     except Tf.ErrorException as exc:
-        raise UsdError(f"{path}: cannot compose stage ({_tf_message(exc)})") from None
+        raise UsdError(f"{path}: cannot compose stage ({usd_reason(exc)})") from None
     errors = stage.GetCompositionErrors() if strict else []
     if errors:
         kinds = sorted({type(e).__name__.removeprefix("Error") for e in errors})
@@ -127,7 +134,8 @@ def check_stage(path: Path) -> None:
         raise UsdError(f"{path}: fails USD validation: {problems[0]}{more}")
 
 
-def _tf_message(exc: Tf.ErrorException) -> str:
+def usd_reason(exc: Tf.ErrorException) -> str:
+    """The message of a pxr error on one line, without its C++ location."""
     text = " ".join(str(exc).split())
     return (text.split(" : ", 1)[-1] if " : " in text else text).strip("' ")
 

@@ -10,9 +10,12 @@ up-corrected axes) is the point that becomes the room frame's origin; ``sgdata t
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from pxr import Usd, UsdGeom
 
+from sgdata.errors import UsdError
 from sgdata.usd.prims import ROOM_ORIGIN, ROOT
 
 __all__ = ["meters_per_unit", "room_prim", "stage_frame", "up_and_units"]
@@ -32,10 +35,21 @@ def room_prim(stage: Usd.Stage) -> Usd.Prim:
 
 
 def meters_per_unit(stage: Usd.Stage) -> float:
-    """The stage's ``metersPerUnit`` as sgdata reads it: 1 when the stage does not author one."""
+    """The stage's ``metersPerUnit`` as sgdata reads it: 1 when the stage does not author one.
+
+    Raises:
+        UsdError: an authored value that is not a positive finite number.
+    """
     # USD's fallback is centimetres; sgdata has always read stages without the field as metres
-    has_units = UsdGeom.StageHasAuthoredMetersPerUnit(stage)
-    return float(UsdGeom.GetStageMetersPerUnit(stage)) if has_units else 1.0
+    if not UsdGeom.StageHasAuthoredMetersPerUnit(stage):
+        return 1.0
+    value = float(UsdGeom.GetStageMetersPerUnit(stage))
+    if not (math.isfinite(value) and value > 0):
+        raise UsdError(
+            f"{stage.GetRootLayer().identifier}: metersPerUnit is {value:g}; expected a positive "
+            "number (1 for metres, 0.01 for centimetres)"
+        )
+    return value
 
 
 def up_and_units(stage: Usd.Stage) -> np.ndarray:
