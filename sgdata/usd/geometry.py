@@ -56,6 +56,20 @@ def read_geometry(path: Path) -> SceneGeometry:
 
 def stage_geometry(stage: Usd.Stage, path: Path) -> SceneGeometry:
     """:func:`read_geometry` of an open stage (``path`` names it in messages)."""
+    with np.errstate(over="ignore", invalid="ignore"):  # overflow is refused just below
+        geometry = _read_stage(stage, path)
+        parts = [(m.name, m.vertices) for m in geometry.structure]
+        parts += [(o.mesh.name, o.world_vertices()) for o in geometry.objects]
+    for name, vertices in parts:
+        if not np.isfinite(vertices).all():
+            raise UsdError(
+                f"{path}: {name} has coordinates that overflow to inf or NaN in metres (a huge "
+                "metersPerUnit, scale or point); expected a room-sized prim"
+            )
+    return geometry
+
+
+def _read_stage(stage: Usd.Stage, path: Path) -> SceneGeometry:
     frame = stage_frame(stage)
     cache = UsdGeom.XformCache(Usd.TimeCode.Default())
     owners: dict[str, Usd.Prim] = {}  # object prim path -> prim, in traversal order

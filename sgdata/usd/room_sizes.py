@@ -12,6 +12,8 @@ from sgdata.usd.stage_frame import meters_per_unit, room_prim
 
 __all__ = ["check_sizes"]
 
+_SLACK = 1.0  # metres an object may stand outside the room (a painting on a wall, a doormat)
+
 
 def check_sizes(
     stage: Usd.Stage,
@@ -21,8 +23,8 @@ def check_sizes(
     max_room: float,
     max_object: float,
 ) -> None:
-    """Refuse a room wider, deeper or taller than ``max_room`` metres, or an object larger than
-    ``max_object`` metres along any side.
+    """Refuse a room wider, deeper or taller than ``max_room`` metres, an object standing
+    outside it, or an object larger than ``max_object`` metres along any side.
 
     A room modelled in centimetres whose ``metersPerUnit`` was left at 1 measures a hundred
     times too large and would otherwise make a dataset of 400 m rooms and 75 m tables.
@@ -51,6 +53,15 @@ def check_sizes(
             f"{units}; a home's room is at most {max_room:g} m a side: "
             + fix.format(key=f"max_room_size (now {max_room:g})")
         )
+    bounds = (room.width, room.depth, room.height)
+    for obj in room.objects:
+        at = (obj.placement.x, obj.placement.y, obj.placement.z)
+        if any(not -_SLACK <= v <= side + _SLACK for v, side in zip(at, bounds, strict=True)):
+            raise UsdError(
+                f"{path}: {measured.paths[obj.instance]} ({obj.class_name}) stands at "
+                f"({_size(at, ', ')}) m, outside the room's {_size(bounds)} m; move it into "
+                "the room or remove it"
+            )
     largest = max(room.objects, key=lambda o: max(o.size), default=None)
     if largest is not None and max(largest.size) > max_object:
         raise UsdError(
@@ -60,5 +71,5 @@ def check_sizes(
         )
 
 
-def _size(sides: tuple[float, ...]) -> str:
-    return " x ".join(f"{v:.3g}" for v in sides)
+def _size(sides: tuple[float, ...], sep: str = " x ") -> str:
+    return sep.join(f"{v:.3g}" for v in sides)

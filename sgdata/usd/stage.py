@@ -13,7 +13,7 @@ from pathlib import Path
 
 from pxr import Sdf, Tf, Usd, UsdValidation
 
-from sgdata.errors import UsdError
+from sgdata.errors import UsdError, one_line
 from sgdata.fileio import atomic_write_text
 
 __all__ = [
@@ -119,7 +119,7 @@ def validate_stage(path: Path) -> list[str]:
     stage = open_stage(path, strict=False)
     context = UsdValidation.ValidationContext(list(_validators()))
     errors = context.Validate(stage)
-    return [_one_line(e.GetErrorAsString()) for e in errors if not e.HasNoError()]
+    return [one_line(e.GetErrorAsString()) for e in errors if not e.HasNoError()]
 
 
 def check_stage(path: Path) -> None:
@@ -136,9 +136,8 @@ def check_stage(path: Path) -> None:
 
 def usd_reason(exc: Tf.ErrorException) -> str:
     """The message of a pxr error on one line, without its C++ location."""
-    text = " ".join(str(exc).split())
+    try:
+        text = one_line(exc)
+    except UnicodeDecodeError:  # pxr quotes the bad bytes of a corrupted file
+        return "its text is not valid UTF-8 where USD stopped reading"
     return (text.split(" : ", 1)[-1] if " : " in text else text).strip("' ")
-
-
-def _one_line(text: str) -> str:
-    return " ".join(text.split())

@@ -13,6 +13,7 @@ import pyarrow.parquet as pq
 
 from sgdata.dataset.paths import observations_path, triplets_path
 from sgdata.dataset.schema import FORMAT_VERSION, observations_schema, schema_at, triplets_schema
+from sgdata.errors import one_line
 from sgdata.validate.loading import SplitTables, column_numpy, read_table_as
 from sgdata.validate.problems import Collector
 
@@ -100,7 +101,7 @@ def _schema_check(root: Path, rel: str, wanted: pa.Schema, out: Collector, extra
     try:
         found = pq.read_schema(root / rel)
     except (pa.ArrowException, OSError) as exc:
-        out.add("tables.schema", rel, f"not a readable Parquet file ({exc})")
+        out.add("tables.schema", rel, f"not a readable Parquet file ({one_line(exc)})")
         return False
     diffs = compare_schema(found, wanted, extra_ok=extra_ok)
     for where, message in diffs:
