@@ -350,6 +350,8 @@ def _convert(hint: Any, value: Any, key: str) -> Any:
     if hint is float:
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise ConfigError(f"key {key!r}: expected a number, got {value!r}")
+        if not math.isfinite(value):  # TOML has nan and inf; no knob means them
+            raise ConfigError(f"key {key!r}: expected a finite number, got {value!r}")
         return float(value)
     if hint is int or hint is bool or hint is str:
         if type(value) is not hint:

@@ -143,7 +143,8 @@ def feed(example: list, work: Path, dataset: Path) -> None:
     files = sorted(p for p in root.rglob("*") if p.is_file())
     for what, k, edit, at, value in example:
         if what == "manifest" and (root / MANIFEST).is_file():
-            _corrupt_manifest(root / MANIFEST, k, edit, value)
+            with contextlib.suppress(ValueError):  # an earlier edit left it unreadable
+                _corrupt_manifest(root / MANIFEST, k, edit, value)
         elif what == "bytes":
             path = files[k % len(files)]
             if path.exists():
