@@ -333,3 +333,13 @@ def test_a_format_1_0_dataset_without_appearance_columns_still_reads(copy: Path)
     edit_manifest(copy, lambda raw: raw.update(format_version="1.1.0"))
     report = validate_dataset(copy, quick=True)
     assert {p.field for p in find(report, "tables.schema")} == set(added)
+
+
+def test_image_column_of_another_type(copy: Path) -> None:
+    # image bytes stored as text raised TypeError in the image checks (found by tests/fuzz)
+    table = pq.read_table(copy / SHARD)
+    at = table.schema.get_field_index("image")
+    texts = pa.array([str(v)[:20] for v in table.column("image").to_pylist()])
+    rewrite(copy, SHARD, table.set_column(at, "image", texts))
+    report = validate_dataset(copy)
+    assert any(p.field == "image" for p in find(report, "tables.schema"))
