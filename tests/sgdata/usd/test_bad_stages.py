@@ -5,11 +5,12 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from pxr import Gf, Usd, UsdGeom
+from pxr import Gf, Sdf, Usd, UsdGeom
 
 from sgdata.errors import UsdError
 from sgdata.usd.geometry import read_geometry
 from sgdata.usd.own_rooms import measure_stage
+from sgdata.usd.room_sizes import check_sizes
 from sgdata.usd.stage import open_stage
 
 from .user_stages import write_user_room
@@ -41,11 +42,29 @@ def mutated(tmp_path: Path, change: str) -> Path:
         UsdGeom.Xformable(stage.GetPrimAtPath("/Room/Mug")).GetOrderedXformOps()[0].Set(
             Gf.Vec3d(float("nan"), 0, 0)
         )
+    elif change == "retyped points":  # string points = "-1" in the .usda text
+        spec = stage.GetRootLayer().GetPrimAtPath(TOP)
+        spec.RemoveProperty(spec.attributes["points"])
+        Sdf.AttributeSpec(spec, "points", Sdf.ValueTypeNames.String).default = "-1"
+    elif change == "retyped translate":
+        spec = stage.GetRootLayer().GetPrimAtPath("/Room/Mug")
+        spec.RemoveProperty(spec.attributes["xformOp:translate"])
+        Sdf.AttributeSpec(spec, "xformOp:translate", Sdf.ValueTypeNames.Int).default = -1
+    elif change == "negative units":
+        stage.SetMetadata("metersPerUnit", -1.0)
+    elif change == "overflowing units":
+        stage.SetMetadata("metersPerUnit", 1e308)
     stage.GetRootLayer().Save()
     return path
 
 
+# found by tests/fuzz: each raised a traceback (ValueError, pxr's ErrorException) or measured a
+# room of NaN before its fix
 CASES = {
+    "retyped points": f"{TOP}.points holds '-1', authored with another value type; expected",
+    "retyped translate": "/Room/Mug/Body: USD cannot compute its transform (Invalid combination",
+    "negative units": "metersPerUnit is -1; expected a positive number (1 for metres, 0.01 for",
+    "overflowing units": "/Room/Shell/Floor has coordinates that overflow to inf or NaN in metres",
     "inf point": f"{TOP} points[0] is (inf, ",
     "negative index": f"{TOP} faceVertexIndices[2] is -1, past the mesh's 8 points",
     "counts disagree": f"{TOP} faceVertexCounts sum to 28 but faceVertexIndices holds 24",
@@ -61,7 +80,7 @@ def test_a_malformed_prim_is_named_in_one_line(tmp_path: Path, change: str) -> N
     with pytest.raises(UsdError) as raised:
         read_geometry(path)
     message = str(raised.value)
-    assert message.startswith(f"{path}: ") and "\n" not in message
+    assert message.startswith(str(path)) and "\n" not in message
     assert CASES[change] in message
 
 
@@ -80,3 +99,16 @@ def test_supports_in_a_circle_are_refused(tmp_path: Path) -> None:
         "round in a circle; expected every chain to end at an object on the floor or a wall: "
         "remove sgdata:support from one of them"
     )
+
+
+def test_an_object_outside_the_room_is_refused(tmp_path: Path) -> None:
+    # a mug 1e300 m away was accepted, then layout sampling overflowed (found by tests/fuzz)
+    path = write_user_room(tmp_path / "room.usda")
+    stage = Usd.Stage.Open(str(path))
+    UsdGeom.Xformable(stage.GetPrimAtPath("/Room/Mug")).GetOrderedXformOps()[0].Set(
+        Gf.Vec3d(1e300, 0, 0)
+    )
+    stage.GetRootLayer().Save()
+    stage = open_stage(path)
+    with pytest.raises(UsdError, match=r"/Room/Mug \(Mug\) stands at \(1e\+300, "):
+        check_sizes(stage, path, measure_stage(stage, path), max_room=30, max_object=5)
