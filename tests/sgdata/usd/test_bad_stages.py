@@ -112,3 +112,12 @@ def test_an_object_outside_the_room_is_refused(tmp_path: Path) -> None:
     stage = open_stage(path)
     with pytest.raises(UsdError, match=r"/Room/Mug \(Mug\) stands at \(1e\+300, "):
         check_sizes(stage, path, measure_stage(stage, path), max_room=30, max_object=5)
+
+
+def test_a_corrupted_byte_in_a_usda_is_one_line(tmp_path: Path) -> None:
+    # pxr's message quotes the bad byte, and str() of it raised UnicodeDecodeError (tests/fuzz)
+    path = write_user_room(tmp_path / "room.usda")
+    data = path.read_bytes()
+    path.write_bytes(data[:7] + bytes([data[7] ^ 0xFF]) + data[8:])
+    with pytest.raises(UsdError, match="unreadable USD layer .its text is not valid UTF-8"):
+        open_stage(path)
