@@ -11,7 +11,13 @@ __all__ = [
     "UsdError",
     "RenderError",
     "DatasetError",
+    "one_line",
 ]
+
+
+def one_line(text: object) -> str:
+    """``text`` (often a library's multi-line message) on one line, for an error message."""
+    return " ".join(str(text).split())
 
 
 class SgdataError(Exception):

@@ -351,7 +351,14 @@ def read_manifest(root: Path) -> Manifest:
             f"{root}: no {MANIFEST}; not an sgdata dataset "
             "(or generation did not finish: run sgdata generate --resume)"
         )
-    return Manifest.from_json(path.read_text(encoding="utf-8"), source=str(path))
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise DatasetError(
+            f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start}); expected the JSON "
+            "manifest generation writes"
+        ) from None
+    return Manifest.from_json(text, source=str(path))
 
 
 def write_manifest(manifest: Manifest, root: Path) -> Path:

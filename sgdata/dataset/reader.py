@@ -20,7 +20,7 @@ from sgdata.dataset.paths import MANIFEST, observations_path, triplets_path
 from sgdata.dataset.rows import sha256_file
 from sgdata.dataset.schema import FORMAT_VERSION, observations_schema, since, triplets_schema
 from sgdata.dataset.storage import image_bytes, is_image_field, memory_column
-from sgdata.errors import DatasetError
+from sgdata.errors import DatasetError, one_line
 
 __all__ = ["Dataset", "decode_image", "read_table"]
 
@@ -100,7 +100,9 @@ def read_table(
         if cast and not table.schema.equals(expected):
             table = table.cast(expected)
     except (pa.ArrowException, OSError, ValueError) as exc:
-        raise DatasetError(f"{path}: not a readable Parquet file of {name} ({exc})") from None
+        raise DatasetError(
+            f"{path}: not a readable Parquet file of {name} ({one_line(exc)})"
+        ) from None
     if not table.schema.equals(expected):
         wrong = [f.name for f in table.schema if not f.equals(expected.field(f.name))]
         raise DatasetError(

@@ -7,6 +7,7 @@ _EXPORTS = {
     "DatasetConfig": ".config",
     "GenerateConfig": ".config",
     "INTERNAL": ".config",
+    "SPARSE": ".config",
     "ImagesConfig": ".config",
     "LayoutsConfig": ".config",
     "PRESETS": ".config",

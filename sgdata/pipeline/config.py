@@ -7,12 +7,14 @@ Each TOML table is one dataclass: ``[dataset]`` -> :class:`DatasetConfig`, ``[ro
 refused with the file and key path in the message; every dataclass validates its own values.
 
 Fields marked :data:`INTERNAL` are set by the loader, never read from TOML nor written to the
-manifest (``RoomsConfig.base_dir``: the folder ``[rooms] files`` are relative to).
+manifest (``RoomsConfig.base_dir``: the folder ``[rooms] files`` are relative to). Fields marked
+:data:`SPARSE` reach the manifest only when set away from their default.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
 import re
 import tomllib
 import types
@@ -41,6 +43,7 @@ __all__ = [
     "LayoutsConfig",
     "PosesConfig",
     "INTERNAL",
+    "SPARSE",
     "ROOM_TYPE_NAME",
     "RoomFile",
     "RoomsConfig",
@@ -51,6 +54,9 @@ __all__ = [
 
 PRESETS = ("tiny", "small", "medium", "paper")
 INTERNAL = {"internal": True}  # field metadata: set by load_config, not a TOML key
+# field metadata: written to the manifest only when set away from its default, so a knob added
+# later leaves the bytes of every dataset made without it unchanged
+SPARSE = {"sparse": True}
 _ROOM_ID = re.compile(r"[A-Za-z0-9][A-Za-z0-9_-]*")
 ROOM_TYPE_NAME = re.compile(r"[a-z][a-z0-9_]*")  # what a user room's type may be
 
@@ -121,6 +127,10 @@ class RoomsConfig:
     files: tuple[RoomFile, ...] = ()  # user rooms, in this order after the procedural ones
     classes: str = ""  # class file for the files' classes (aliases of catalog classes)
     base_dir: str = field(default="", metadata=INTERNAL)  # files' folder ("": working dir)
+    # the largest room side and object side (metres) a user room may measure: beyond them it was
+    # most likely modelled in other units (docs/rooms.md); raise them for rooms really that large
+    max_room_size: float = field(default=30.0, metadata=SPARSE)
+    max_object_size: float = field(default=5.0, metadata=SPARSE)
 
     def __post_init__(self) -> None:
         if self.types is None:
@@ -145,6 +155,10 @@ class RoomsConfig:
                     f'{entry.id!r}; give one another: {{ path = {entry.path!r}, id = "..." }}'
                 )
             seen[entry.id] = entry.path
+        for key in ("max_room_size", "max_object_size"):
+            value = getattr(self, key)
+            if not math.isfinite(value) or value <= 0:
+                raise ConfigError(f"rooms.{key} must be a positive number of metres, got {value}")
 
     @property
     def procedural_types(self) -> tuple[str, ...]:
@@ -264,7 +278,11 @@ def load_config(source: str | Path) -> GenerateConfig:
 def config_to_dict(config: Any) -> Any:
     """Plain JSON-able form of a config (tuples become lists), for the manifest."""
     if dataclasses.is_dataclass(config):
-        return {f.name: config_to_dict(getattr(config, f.name)) for f in _public_fields(config)}
+        return {
+            f.name: config_to_dict(getattr(config, f.name))
+            for f in _public_fields(config)
+            if not (f.metadata.get("sparse") and getattr(config, f.name) == f.default)
+        }
     if isinstance(config, dict):
         return {str(k): config_to_dict(v) for k, v in config.items()}
     if isinstance(config, tuple | list):
@@ -332,6 +350,8 @@ def _convert(hint: Any, value: Any, key: str) -> Any:
     if hint is float:
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise ConfigError(f"key {key!r}: expected a number, got {value!r}")
+        if not math.isfinite(value):  # TOML has nan and inf; no knob means them
+            raise ConfigError(f"key {key!r}: expected a finite number, got {value!r}")
         return float(value)
     if hint is int or hint is bool or hint is str:
         if type(value) is not hint:

@@ -43,7 +43,8 @@ def resolve_user_rooms(config: GenerateConfig, *, taken: Collection[str] = ()) -
             taken, the file's ``sgdata:roomType`` is no type name; naming the entry
             (``rooms.files[k]``) and the file.
         UsdError: a file is not a readable stage, has no ``sgdata:class`` prim, uses a class
-            that is neither in the catalog nor an alias, or cannot be measured.
+            that is neither in the catalog nor an alias, cannot be measured, or measures larger
+            than ``[rooms] max_room_size`` / ``max_object_size`` (likely other units).
     """
     rooms = config.rooms
     if not rooms.files:
@@ -70,7 +71,7 @@ def resolve_user_rooms(config: GenerateConfig, *, taken: Collection[str] = ()) -
                 f"{where}: the file's sha256 is {digest}, not the {entry.sha256} the config pins"
             )
         try:
-            room = _inspect(path, classes, catalog)
+            room = _inspect(path, classes, catalog, rooms)
         except SgdataError as exc:
             raise type(exc)(f"rooms.files[{k}]: {exc}") from None
         room_type = entry.type or room.room_type  # measure_stage's default: "custom"
@@ -125,10 +126,12 @@ def _class_file(rooms: RoomsConfig, catalog: Catalog) -> UserClasses:
         raise ConfigError(f"rooms.classes: {exc}") from None
 
 
-def _inspect(path: Path, classes: UserClasses, catalog: Catalog) -> Room:
-    """The room of a user's file, measured; every class a catalog class or an alias of one."""
+def _inspect(path: Path, classes: UserClasses, catalog: Catalog, rooms: RoomsConfig) -> Room:
+    """The room of a user's file, measured; every class a catalog class or an alias of one, and
+    every size one a home holds."""
     from sgdata.usd.object_prims import object_prims
     from sgdata.usd.own_rooms import measure_stage
+    from sgdata.usd.room_sizes import check_sizes
     from sgdata.usd.stage import open_stage
 
     stage = open_stage(path)
@@ -145,4 +148,8 @@ def _inspect(path: Path, classes: UserClasses, catalog: Catalog) -> Room:
                 f"{path}: {prim.GetPath()} sgdata:class {name!r} is not a catalog class; "
                 f'map it onto one in the [rooms] classes file, e.g. {name} = "Mug"'
             )
-    return measure_stage(stage, path, classes=classes.dynamics, catalog=catalog).room
+    measured = measure_stage(stage, path, classes=classes.dynamics, catalog=catalog)
+    check_sizes(
+        stage, path, measured, max_room=rooms.max_room_size, max_object=rooms.max_object_size
+    )
+    return measured.room

@@ -7,7 +7,7 @@ than three corners are fanned into triangles; ``primvars:displayColor`` gives th
 (constant, uniform, vertex and faceVarying interpolation; grey when absent). Bound materials
 override it where they say more (:mod:`sgdata.usd.bound_materials`): a textured face carries
 its texture file and coordinates, and the texture's colour factor as its face colour. The
-stage's light (``sgdata:light:*`` on its room prim, :mod:`sgdata.usd.looks`) comes back as
+stage's light (``sgdata:light:*`` on its room prim, :mod:`sgdata.usd.prims`) comes back as
 :class:`~sgdata.usd.meshes.Lighting`.
 """
 
@@ -17,14 +17,15 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
-from pxr import Usd, UsdGeom
+from pxr import Tf, Usd, UsdGeom
 
+from sgdata.errors import UsdError
 from sgdata.usd.bound_materials import MaterialReader
 from sgdata.usd.gprims import tessellate_gprim
-from sgdata.usd.looks import LIGHT_INTENSITY, LIGHT_TEMPERATURE
 from sgdata.usd.meshes import Lighting, MeshData, ObjectGeometry, SceneGeometry, merge_meshes
 from sgdata.usd.object_prims import drawn_prims, instance_ids, is_object
-from sgdata.usd.stage import open_stage
+from sgdata.usd.prims import LIGHT_INTENSITY, LIGHT_TEMPERATURE
+from sgdata.usd.stage import open_stage, usd_reason
 from sgdata.usd.stage_frame import room_prim, stage_frame
 from sgdata.world.appearance import light_color
 from sgdata.world.scene import transform_points
@@ -44,8 +45,10 @@ def read_geometry(path: Path) -> SceneGeometry:
     units and origin.
 
     Raises:
-        UsdError: the file is missing, unreadable or does not compose, or an object prim has
-            a non-integer or duplicate ``sgdata:instance``.
+        UsdError: the file is missing, unreadable or does not compose, an object prim has
+            a non-integer or duplicate ``sgdata:instance``, a mesh is malformed (NaN or inf
+            points, an index past its points), a gprim's size is not positive, or a transform
+            is not finite or (for an object) singular.
     """
     path = Path(path)
     return stage_geometry(open_stage(path), path)
@@ -53,6 +56,20 @@ def read_geometry(path: Path) -> SceneGeometry:
 
 def stage_geometry(stage: Usd.Stage, path: Path) -> SceneGeometry:
     """:func:`read_geometry` of an open stage (``path`` names it in messages)."""
+    with np.errstate(over="ignore", invalid="ignore"):  # overflow is refused just below
+        geometry = _read_stage(stage, path)
+        parts = [(m.name, m.vertices) for m in geometry.structure]
+        parts += [(o.mesh.name, o.world_vertices()) for o in geometry.objects]
+    for name, vertices in parts:
+        if not np.isfinite(vertices).all():
+            raise UsdError(
+                f"{path}: {name} has coordinates that overflow to inf or NaN in metres (a huge "
+                "metersPerUnit, scale or point); expected a room-sized prim"
+            )
+    return geometry
+
+
+def _read_stage(stage: Usd.Stage, path: Path) -> SceneGeometry:
     frame = stage_frame(stage)
     cache = UsdGeom.XformCache(Usd.TimeCode.Default())
     owners: dict[str, Usd.Prim] = {}  # object prim path -> prim, in traversal order
@@ -63,16 +80,28 @@ def stage_geometry(stage: Usd.Stage, path: Path) -> SceneGeometry:
         if is_object(prim):
             owners[str(prim.GetPath())] = prim
             parts.setdefault(str(prim.GetPath()), [])
-        found = _prim_triangles(prim, materials)
+        try:
+            _check_value_types(prim)
+            found = _prim_triangles(prim, materials)
+        except UsdError as exc:
+            raise UsdError(f"{path}: {exc}") from None
         if found is None:
             continue
-        world = _world(cache, prim, frame)
+        try:
+            world = _world(cache, prim, frame)
+        except UsdError as exc:
+            raise UsdError(f"{path}: {exc}") from None
         owner = _owner(prim, owners)
+        if not np.isfinite(world).all():
+            raise UsdError(
+                f"{path}: {prim.GetPath()} has a transform with NaN or infinite values "
+                "(its own xformOps or an ancestor's); expected finite numbers"
+            )
         if owner is None:
             vertices = transform_points(world, found.vertices)
             structure.append(replace(found, vertices=vertices, name=str(prim.GetPath())))
         else:
-            to_owner = np.linalg.inv(_world(cache, owner, frame)) @ world
+            to_owner = _inverse(path, owner, _world(cache, owner, frame)) @ world
             if not np.allclose(to_owner, np.eye(4), rtol=0.0, atol=1e-12):
                 found = replace(found, vertices=transform_points(to_owner, found.vertices))
             # else: a mesh in its object's own frame keeps its exact vertices, so a moved
@@ -136,22 +165,58 @@ def _owner(prim: Usd.Prim, owners: dict[str, Usd.Prim]) -> Usd.Prim | None:
 
 
 def _world(cache: UsdGeom.XformCache, prim: Usd.Prim, frame: np.ndarray | None) -> np.ndarray:
-    # USD matrices act on row vectors (p' = p M): transpose for the column convention
-    m = np.array(cache.GetLocalToWorldTransform(prim), dtype=np.float64).T
+    try:
+        # USD matrices act on row vectors (p' = p M): transpose for the column convention
+        m = np.array(cache.GetLocalToWorldTransform(prim), dtype=np.float64).T
+    except Tf.ErrorException as exc:  # e.g. an xformOp authored with the wrong value type
+        reason = usd_reason(exc)
+        raise UsdError(f"{prim.GetPath()}: USD cannot compute its transform ({reason})") from None
     return m if frame is None else frame @ m
+
+
+def _inverse(path: Path, owner: Usd.Prim, matrix: np.ndarray) -> np.ndarray:
+    """The inverse of an object's world matrix; a singular one (a zero scale) cannot place it."""
+    if abs(np.linalg.det(matrix[:3, :3])) < 1e-18:
+        raise UsdError(
+            f"{path}: {owner.GetPath()} has a singular transform (a zero scale in its xformOps "
+            "or an ancestor's); expected an invertible one"
+        )
+    return np.linalg.inv(matrix)
 
 
 def _triangles(mesh: UsdGeom.Mesh, materials: MaterialReader) -> MeshData:
     """Fan-triangulate a mesh; colours per triangle from its displayColor primvar, then from
-    its bound materials (with their textures)."""
+    its bound materials (with their textures).
+
+    Raises:
+        UsdError: points that are not finite, face counts that disagree with the indices, or an
+            index outside the points (names the prim, without the file).
+    """
+    where = mesh.GetPath()
     points = mesh.GetPointsAttr().Get()
     counts = mesh.GetFaceVertexCountsAttr().Get()
     indices = mesh.GetFaceVertexIndicesAttr().Get()
     vertices = np.array(points, dtype=np.float64).reshape(-1, 3) if points else np.zeros((0, 3))
     counts = np.array(counts, dtype=np.int64) if counts else np.zeros(0, np.int64)
     indices = np.array(indices, dtype=np.int64) if indices else np.zeros(0, np.int64)
-    if counts.sum() != len(indices) or (len(indices) and indices.max() >= len(vertices)):
-        return MeshData(np.zeros((0, 3)), np.zeros((0, 3), np.int32), np.zeros((0, 3), np.float32))
+    if not np.isfinite(vertices).all():
+        k = int(np.flatnonzero(~np.isfinite(vertices).all(axis=1))[0])
+        raise UsdError(
+            f"{where} points[{k}] is {tuple(vertices[k].tolist())}; expected finite numbers "
+            "(no NaN or inf): fix or remove that point"
+        )
+    if (counts < 0).any() or counts.sum() != len(indices):
+        raise UsdError(
+            f"{where} faceVertexCounts sum to {int(counts.sum())} but faceVertexIndices holds "
+            f"{len(indices)} indices; expected one index per face corner (and no negative count)"
+        )
+    outside = (indices < 0) | (indices >= len(vertices))
+    if outside.any():
+        k = int(np.flatnonzero(outside)[0])
+        raise UsdError(
+            f"{where} faceVertexIndices[{k}] is {int(indices[k])}, past the mesh's "
+            f"{len(vertices)} points; expected indices in [0, {len(vertices)}): fix the index"
+        )
     starts = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
     tri_counts = np.maximum(counts - 2, 0)
     face_of = np.repeat(np.arange(len(counts)), tri_counts)  # source face of each triangle
@@ -177,6 +242,28 @@ def _triangles(mesh: UsdGeom.Mesh, materials: MaterialReader) -> MeshData:
         face_texture=bound.face_texture if textured else None,
         textures=bound.files if textured else (),
     )
+
+
+# Python types of scalar values (pxr gives no pythonClass for them)
+_SCALARS = {"double": float, "float": float, "half": float, "int": int, "int64": int,
+            "uint": int, "token": str, "string": str, "bool": bool}  # fmt: skip
+
+
+def _check_value_types(prim: Usd.Prim) -> None:
+    """Refuse an attribute authored with another value type than its schema's (a wrong
+    typeName in a hand-written file: ``string points = "1"``) rather than misread it."""
+    for attr in prim.GetAuthoredAttributes():
+        value = attr.Get()
+        name = attr.GetTypeName()
+        expected = name.type.pythonClass or _SCALARS.get(str(name))
+        if value is None or expected is None or isinstance(value, expected):
+            continue
+        if expected is float and isinstance(value, int):
+            continue
+        shown = repr(value) if len(repr(value)) < 40 else repr(value)[:37] + "..."
+        raise UsdError(
+            f"{attr.GetPath()} holds {shown}, authored with another value type; expected {name}"
+        )
 
 
 def _display_color(mesh: UsdGeom.Gprim) -> tuple[np.ndarray, str] | None:

@@ -27,7 +27,7 @@ from sgdata.errors import SceneError, UsdError
 from sgdata.scene_files import ROOM_FILE
 from sgdata.usd.looks import RoomParts, define_layout_materials, override_light, override_look
 from sgdata.usd.own_layouts import OwnFrame, override_own
-from sgdata.usd.room_io import ROOT, object_path
+from sgdata.usd.prims import ROOT, object_path
 from sgdata.usd.stage import open_layer, write_text_atomic
 from sgdata.world.appearance import LayoutAppearance
 from sgdata.world.scene import Room, SceneObject

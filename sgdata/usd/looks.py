@@ -33,7 +33,15 @@ from sgdata.usd.materials import (
     tinted_material_path,
     write_texture_files,
 )
-from sgdata.usd.room_io import OBJECTS, ROOT
+from sgdata.usd.prims import (
+    LIGHT_INTENSITY,
+    LIGHT_TEMPERATURE,
+    LOOK_TEXTURE,
+    LOOK_TINT,
+    LOOK_VARIANT,
+    OBJECTS,
+    ROOT,
+)
 from sgdata.usd.stage import open_stage
 from sgdata.usd.stage_frame import room_prim
 from sgdata.world.appearance import AppearanceConfig, LayoutAppearance, Look, room_looks, tinted
@@ -42,11 +50,6 @@ from sgdata.world.scene import Room, SceneObject
 from sgdata.world.shapes.uvs import box_uvs
 
 __all__ = [
-    "LIGHT_INTENSITY",
-    "LIGHT_TEMPERATURE",
-    "LOOK_TEXTURE",
-    "LOOK_TINT",
-    "LOOK_VARIANT",
     "ObjectParts",
     "RoomDresser",
     "RoomParts",
@@ -56,11 +59,6 @@ __all__ = [
     "read_room_parts",
 ]
 
-LIGHT_INTENSITY = "sgdata:light:intensity"
-LIGHT_TEMPERATURE = "sgdata:light:colorTemperature"
-LOOK_TEXTURE = "sgdata:look:texture"
-LOOK_VARIANT = "sgdata:look:variant"
-LOOK_TINT = "sgdata:look:tint"
 _DISPLAY_COLOR = "primvars:displayColor"
 
 

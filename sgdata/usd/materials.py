@@ -40,11 +40,10 @@ from pxr import Gf, Sdf, Usd, UsdGeom, UsdShade, Vt
 
 from sgdata.errors import UsdError
 from sgdata.fileio import atomic_write_bytes
-from sgdata.usd.room_io import ROOT
+from sgdata.usd.prims import LOOKS
 from sgdata.world.textures import TEXTURE_KINDS, texture_file_name, texture_image
 
 __all__ = [
-    "LOOKS",
     "PART_FAMILY",
     "PART_PREFIX",
     "base_material_path",
@@ -58,7 +57,6 @@ __all__ = [
     "write_texture_files",
 ]
 
-LOOKS = ROOT.AppendChild("Looks")
 PART_FAMILY = "materialBind"  # UsdShade's family name for per-face material bindings
 PART_PREFIX = "part_"  # subset k of a mesh holds the faces of its k-th displayColor value
 _TINT = "tint"

@@ -29,7 +29,8 @@ from pxr import Usd
 from sgdata.errors import UsdError
 from sgdata.usd.geometry import stage_geometry
 from sgdata.usd.meshes import MeshData, ObjectGeometry
-from sgdata.usd.stage_frame import ROOM_ORIGIN, room_prim
+from sgdata.usd.prims import ROOM_ORIGIN
+from sgdata.usd.stage_frame import room_prim
 from sgdata.world.catalog import Catalog, load_catalog
 from sgdata.world.scene import WALLS, Dynamics, Opening, Placement, Room, SceneObject
 
@@ -90,7 +91,8 @@ def measure_stage(
 
     Raises:
         UsdError: no room prim, an object without geometry, a class neither in the catalog nor
-            in ``classes`` without ``sgdata:dynamics``, or a bad ``sgdata:support`` target.
+            in ``classes`` without ``sgdata:dynamics``, a bad ``sgdata:support`` target, or
+            supports (or attachments) that go round in a circle.
     """
     root = room_prim(stage)
     if not root.IsValid():
@@ -150,6 +152,7 @@ def measure_stage(
             )
         )
     objects = _infer_supports(objects, stage, paths, inferred)
+    _check_acyclic(path, objects, paths)
     shell = Room(
         room_id=str(_value(root, "sgdata:roomId", path.stem)),
         room_type=str(_value(root, "sgdata:roomType", "custom")),
@@ -424,6 +427,26 @@ def _infer_supports(
             obj = obj.moved_to(obj.placement, support)
         out.append(obj)
     return out
+
+
+def _check_acyclic(path: Path, objects: list[SceneObject], paths: dict[int, str]) -> None:
+    """Refuse objects that rest on (or hang from) each other in a circle: nothing would hold
+    them up, and moving one would move the others without end."""
+    for link in ("support", "attached_to"):
+        up = {o.instance: getattr(o, link) for o in objects}
+        for start in up:
+            seen, at = [start], up[start]
+            while at is not None and at not in seen:
+                seen.append(at)
+                at = up.get(at)
+            if at is not None:
+                circle = seen[seen.index(at) :] + [at]
+                name = "sgdata:support" if link == "support" else "sgdata:attachedTo"
+                raise UsdError(
+                    f"{path}: {' -> '.join(paths[i] for i in circle)}: {name} goes round in a "
+                    f"circle; expected every chain to end at an object on the floor or a wall: "
+                    f"remove {name} from one of them"
+                )
 
 
 def _support_of(obj: SceneObject, objects: list[SceneObject]) -> int | None:

@@ -36,6 +36,7 @@ import numpy as np
 from pxr import Gf, Kind, Sdf, Usd, UsdGeom, Vt
 
 from sgdata.errors import SceneError, UsdError
+from sgdata.usd.prims import OBJECTS, ROOT, STRUCTURE, object_path
 from sgdata.usd.stage import open_stage, write_text_atomic
 from sgdata.world.scene import WALLS, Dynamics, Opening, Placement, Room, SceneObject
 
@@ -45,19 +46,12 @@ if TYPE_CHECKING:
     from sgdata.world.catalog import Catalog
 
 __all__ = [
-    "ROOT",
-    "OBJECTS",
-    "STRUCTURE",
     "Geometry",
     "catalog_geometry",
     "write_room",
     "read_room",
-    "object_path",
 ]
 
-ROOT = Sdf.Path("/Room")
-OBJECTS = ROOT.AppendChild("Objects")
-STRUCTURE = ROOT.AppendChild("Structure")
 WALL_THICKNESS = 0.1  # metres, outside the room rectangle
 SLAB_THICKNESS = 0.1  # floor below z = 0, ceiling above z = height
 
@@ -165,11 +159,6 @@ def write_room(
     if dresser is not None:
         dresser.finish()
     write_text_atomic(path, stage.GetRootLayer().ExportToString())
-
-
-def object_path(obj: SceneObject) -> Sdf.Path:
-    """The prim path of an object: ``/Room/Objects/<Class>_<instance:04d>``."""
-    return OBJECTS.AppendChild(obj.prim_name)
 
 
 def _define_object(

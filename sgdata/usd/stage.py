@@ -13,10 +13,17 @@ from pathlib import Path
 
 from pxr import Sdf, Tf, Usd, UsdValidation
 
-from sgdata.errors import UsdError
+from sgdata.errors import UsdError, one_line
 from sgdata.fileio import atomic_write_text
 
-__all__ = ["open_layer", "open_stage", "write_text_atomic", "validate_stage", "check_stage"]
+__all__ = [
+    "open_layer",
+    "open_stage",
+    "write_text_atomic",
+    "validate_stage",
+    "check_stage",
+    "usd_reason",
+]
 
 
 def write_text_atomic(path: Path, text: str) -> None:
@@ -51,7 +58,7 @@ def open_layer(path: Path, what: str | None = None) -> Sdf.Layer:
         else:
             layer = Sdf.Layer.FindOrOpen(str(path))
     except Tf.ErrorException as exc:
-        raise UsdError(f"{what}: unreadable USD layer ({_tf_message(exc)})") from None
+        raise UsdError(f"{what}: unreadable USD layer ({usd_reason(exc)})") from None
     if layer is None:
         raise UsdError(f"{what}: unreadable USD layer")
     return layer
@@ -85,7 +92,7 @@ def open_stage(path: Path, *, strict: bool = True) -> Usd.Stage:
     try:
         stage = Usd.Stage.Open(layer)
     except Tf.ErrorException as exc:
-        raise UsdError(f"{path}: cannot compose stage ({_tf_message(exc)})") from None
+        raise UsdError(f"{path}: cannot compose stage ({usd_reason(exc)})") from None
     errors = stage.GetCompositionErrors() if strict else []
     if errors:
         kinds = sorted({type(e).__name__.removeprefix("Error") for e in errors})
@@ -112,7 +119,7 @@ def validate_stage(path: Path) -> list[str]:
     stage = open_stage(path, strict=False)
     context = UsdValidation.ValidationContext(list(_validators()))
     errors = context.Validate(stage)
-    return [_one_line(e.GetErrorAsString()) for e in errors if not e.HasNoError()]
+    return [one_line(e.GetErrorAsString()) for e in errors if not e.HasNoError()]
 
 
 def check_stage(path: Path) -> None:
@@ -127,10 +134,10 @@ def check_stage(path: Path) -> None:
         raise UsdError(f"{path}: fails USD validation: {problems[0]}{more}")
 
 
-def _tf_message(exc: Tf.ErrorException) -> str:
-    text = " ".join(str(exc).split())
+def usd_reason(exc: Tf.ErrorException) -> str:
+    """The message of a pxr error on one line, without its C++ location."""
+    try:
+        text = one_line(exc)
+    except UnicodeDecodeError:  # pxr quotes the bad bytes of a corrupted file
+        return "its text is not valid UTF-8 where USD stopped reading"
     return (text.split(" : ", 1)[-1] if " : " in text else text).strip("' ")
-
-
-def _one_line(text: str) -> str:
-    return " ".join(text.split())

@@ -10,13 +10,16 @@ up-corrected axes) is the point that becomes the room frame's origin; ``sgdata t
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
-from pxr import Sdf, Usd, UsdGeom
+from pxr import Usd, UsdGeom
 
-__all__ = ["ROOM_ORIGIN", "room_prim", "stage_frame", "up_and_units"]
+from sgdata.errors import UsdError
+from sgdata.usd.prims import ROOM_ORIGIN, ROOT
 
-ROOM_ORIGIN = "sgdata:roomOrigin"
-_ROOM = Sdf.Path("/Room")
+__all__ = ["meters_per_unit", "room_prim", "stage_frame", "up_and_units"]
+
 
 # stage axes -> Z-up axes: a Y-up stage's +Y becomes +Z, its +Z becomes -Y (a +90 degree turn
 # about X), so right-handed frames stay right-handed
@@ -25,17 +28,33 @@ _Y_UP = np.array([[1.0, 0, 0, 0], [0, 0, -1.0, 0], [0, 1.0, 0, 0], [0, 0, 0, 1.0
 
 def room_prim(stage: Usd.Stage) -> Usd.Prim:
     """The room prim: ``/Room`` when present, else the stage's default prim (maybe invalid)."""
-    prim = stage.GetPrimAtPath(_ROOM)
+    prim = stage.GetPrimAtPath(ROOT)
     if prim.IsValid():
         return prim
     return stage.GetDefaultPrim()
 
 
+def meters_per_unit(stage: Usd.Stage) -> float:
+    """The stage's ``metersPerUnit`` as sgdata reads it: 1 when the stage does not author one.
+
+    Raises:
+        UsdError: an authored value that is not a positive finite number.
+    """
+    # USD's fallback is centimetres; sgdata has always read stages without the field as metres
+    if not UsdGeom.StageHasAuthoredMetersPerUnit(stage):
+        return 1.0
+    value = float(UsdGeom.GetStageMetersPerUnit(stage))
+    if not (math.isfinite(value) and value > 0):
+        raise UsdError(
+            f"{stage.GetRootLayer().identifier}: metersPerUnit is {value:g}; expected a positive "
+            "number (1 for metres, 0.01 for centimetres)"
+        )
+    return value
+
+
 def up_and_units(stage: Usd.Stage) -> np.ndarray:
     """The 4x4 transform (column convention) turning stage axes and units into Z-up metres."""
-    # USD's fallback is centimetres; sgdata has always read stages without the field as metres
-    has_units = UsdGeom.StageHasAuthoredMetersPerUnit(stage)
-    scale = float(UsdGeom.GetStageMetersPerUnit(stage)) if has_units else 1.0
+    scale = meters_per_unit(stage)
     m = np.diag([scale, scale, scale, 1.0])
     if UsdGeom.GetStageUpAxis(stage) == UsdGeom.Tokens.y:
         m = _Y_UP @ m

@@ -23,9 +23,10 @@ from pxr import Gf, Sdf, Usd, UsdGeom
 from sgdata.errors import ConfigError
 from sgdata.scene_files import ROOM_FILE
 from sgdata.usd.own_rooms import MEASURED, measure_stage
+from sgdata.usd.prims import ROOM_ORIGIN
 from sgdata.usd.room_io import read_room
 from sgdata.usd.stage import open_stage, validate_stage, write_text_atomic
-from sgdata.usd.stage_frame import ROOM_ORIGIN, room_prim
+from sgdata.usd.stage_frame import room_prim
 from sgdata.world.catalog import Catalog, load_catalog
 from sgdata.world.room_checks import room_problems
 from sgdata.world.scene import Room

@@ -11,6 +11,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 from PIL import Image
 
+from sgdata.dataset.schema import observations_schema
 from sgdata.dataset.storage import memory_column
 from sgdata.errors import DatasetError
 from sgdata.validate.problems import Collector
@@ -48,6 +49,9 @@ def check_images(root: Path, files: list[str], out: Collector, *, workers: int =
                 table = pq.read_table(root / rel, columns=columns)
             except (pa.ArrowException, OSError, ValueError):
                 continue  # reported by the table checks
+            expected = observations_schema()
+            if any(not table.schema.field(c).type.equals(expected.field(c).type) for c in columns):
+                continue  # a column of another type: reported by the table checks
             camera = table.column("camera").combine_chunks()
             width = camera.field("width").to_numpy(zero_copy_only=False).astype(np.int64)
             height = camera.field("height").to_numpy(zero_copy_only=False).astype(np.int64)

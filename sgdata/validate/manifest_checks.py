@@ -15,7 +15,7 @@ from sgdata.dataset.manifest import Manifest
 from sgdata.dataset.paths import MANIFEST
 from sgdata.dataset.rows import sha256_file
 from sgdata.dataset.schema import check_compatible, manifest_json_schema
-from sgdata.errors import DatasetError
+from sgdata.errors import DatasetError, one_line
 from sgdata.validate.problems import Collector
 
 __all__ = ["read_raw_manifest", "check_manifest", "check_files", "check_splits"]
@@ -39,7 +39,7 @@ def read_raw_manifest(root: Path, out: Collector) -> dict[str, Any] | None:
     try:
         raw = json.loads(path.read_text(encoding="utf-8"))
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        out.add("manifest.json", MANIFEST, f"not readable JSON ({exc})")
+        out.add("manifest.json", MANIFEST, f"not readable JSON ({one_line(exc)})")
         return None
     if not isinstance(raw, dict):
         out.add("manifest.json", MANIFEST, f"expected a JSON object, got {type(raw).__name__}")
@@ -91,7 +91,7 @@ def check_files(root: Path, raw: dict[str, Any], out: Collector) -> None:
             try:
                 rows = pq.ParquetFile(path).metadata.num_rows
             except (pa.ArrowException, OSError) as exc:
-                out.add("files.rows", rel, f"not a readable Parquet file ({exc})")
+                out.add("files.rows", rel, f"not a readable Parquet file ({one_line(exc)})")
             else:
                 if rows != entry["rows"]:
                     out.add(

@@ -19,10 +19,15 @@ __all__ = ["check_recompute"]
 
 def _rules(raw: dict[str, Any]) -> RelationRules:
     r = raw.get("relation_rules", {})
-    return RelationRules(
-        box=str(r.get("box", "world_aabb")),
-        containment_tolerance=float(r.get("containment_tolerance", 0.0)),
-    )
+    try:
+        return RelationRules(
+            box=str(r.get("box", "world_aabb")),
+            containment_tolerance=float(r.get("containment_tolerance", 0.0)),
+        )
+    except (AttributeError, TypeError, ValueError):  # the manifest's schema leaves it open
+        raise ConfigError(
+            f"relation_rules is {r!r}; expected a table with box and containment_tolerance"
+        ) from None
 
 
 def check_recompute(

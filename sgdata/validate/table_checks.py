@@ -12,8 +12,14 @@ import pyarrow.compute as pc
 import pyarrow.parquet as pq
 
 from sgdata.dataset.paths import observations_path, triplets_path
-from sgdata.dataset.schema import FORMAT_VERSION, file_schema, observations_schema, triplets_schema
+from sgdata.dataset.schema import (
+    FORMAT_VERSION,
+    file_schema,
+    observations_schema,
+    triplets_schema,
+)
 from sgdata.dataset.storage import HF_METADATA_KEY
+from sgdata.errors import one_line
 from sgdata.validate.loading import SplitTables, column_numpy, read_table_as
 from sgdata.validate.problems import Collector
 
@@ -101,7 +107,7 @@ def _schema_check(root: Path, rel: str, wanted: pa.Schema, out: Collector, extra
     try:
         found = pq.read_schema(root / rel)
     except (pa.ArrowException, OSError) as exc:
-        out.add("tables.schema", rel, f"not a readable Parquet file ({exc})")
+        out.add("tables.schema", rel, f"not a readable Parquet file ({one_line(exc)})")
         return False
     diffs = compare_schema(found, wanted, extra_ok=extra_ok)
     hf = (wanted.metadata or {}).get(HF_METADATA_KEY)

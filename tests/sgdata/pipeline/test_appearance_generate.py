@@ -17,7 +17,7 @@ import pyarrow.compute as pc
 from sgdata.dataset import Dataset
 from sgdata.pipeline.config import load_config
 from sgdata.pipeline.generate import LEDGER, generate_dataset
-from sgdata.usd.looks import LIGHT_INTENSITY, LIGHT_TEMPERATURE
+from sgdata.usd.prims import LIGHT_INTENSITY, LIGHT_TEMPERATURE
 from sgdata.usd.stage import open_stage
 
 # Two small textured rooms (2 workers really run in parallel), 48 px views, few triplets.

@@ -13,9 +13,10 @@ import pyarrow.parquet as pq
 import pytest
 from pxr import Sdf, Usd, UsdGeom
 
-from sgdata.errors import ConfigError
-from sgdata.pipeline.config import GenerateConfig, RoomsConfig, load_config
+from sgdata.errors import ConfigError, UsdError
+from sgdata.pipeline.config import GenerateConfig, RoomsConfig, config_to_dict, load_config
 from sgdata.pipeline.generate import LEDGER, plan_rooms
+from sgdata.pipeline.user_rooms import resolve_user_rooms
 
 from ..usd.user_stages import write_user_room
 
@@ -153,6 +154,19 @@ def test_generate_user_rooms_end_to_end(tmp_path: Path) -> None:
     assert "'rooms/yup.usda' changed since the dataset was made" in problems[0]["message"]
 
 
+FRIDGE_BODY = "/Room/Fridge/Body"
+
+
+def set_points(path: Path, prim: str, k: int, value: float) -> None:
+    """Set every coordinate of point ``k`` of a mesh to ``value``."""
+    stage = Usd.Stage.Open(str(path))
+    attr = UsdGeom.Mesh(stage.GetPrimAtPath(prim)).GetPointsAttr()
+    points = list(attr.Get())
+    points[k] = (value, value, value)
+    attr.Set(points)
+    stage.GetRootLayer().Save()
+
+
 def write_bad_project(folder: Path, case: str) -> Path:
     config = write_project(folder)
     rooms = folder / "rooms"
@@ -173,6 +187,19 @@ def write_bad_project(folder: Path, case: str) -> Path:
         text = text.replace('split = "val"', 'split = "dev"')
     elif case == "not usd":
         (rooms / "yup.usda").write_text("this is not USD\n")
+    elif case == "nan in a mesh":  # crashed generate with OverflowError (issue 26)
+        set_points(rooms / "kitchen corner.usda", "/Room/Things/Table/Top", 3, float("nan"))
+    elif case == "face index past the points":  # was "has no geometry to measure" (issue 26)
+        stage = Usd.Stage.Open(str(rooms / "opt.usda"))
+        attr = UsdGeom.Mesh(stage.GetPrimAtPath(FRIDGE_BODY)).GetFaceVertexIndicesAttr()
+        indices = list(attr.Get())
+        indices[5] = 8  # the box has points 0..7
+        attr.Set(indices)
+        stage.GetRootLayer().Save()
+    elif case == "centimetres at metersPerUnit 1":  # was a 400 m room (issue 26)
+        stage = Usd.Stage.Open(str(rooms / "yup.usda"))
+        UsdGeom.SetStageMetersPerUnit(stage, 1.0)
+        stage.GetRootLayer().Save()
     config.write_text(text)
     return config
 
@@ -185,6 +212,13 @@ BAD = {
     "alias of no catalog class": "class 'Teacup' is 'Cupp'; expected",
     "bad split": "rooms/yup.usda': split 'dev'; expected one of",
     "not usd": "rooms.files[1]: ",
+    "nan in a mesh": "/Room/Things/Table/Top points[3] is (nan, ",
+    "face index past the points": "/Room/Fridge/Body faceVertexIndices[5] is 8, past the mesh's 8",
+    "centimetres at metersPerUnit 1": (
+        "yup.usda: /Room measures 400 x 300 x 250 m with the stage's metersPerUnit 1 and "
+        "upAxis Y; a home's room is at most 30 m a side: if the file is in centimetres set its "
+        "metersPerUnit = 0.01"
+    ),
 }
 
 
@@ -250,7 +284,6 @@ def test_a_procedural_room_id_is_refused(tmp_path: Path) -> None:
 
 
 def test_pinned_sha256_and_type_from_the_file(tmp_path: Path) -> None:
-    from sgdata.pipeline.user_rooms import resolve_user_rooms
 
     path = write_user_room(tmp_path / "room.usda")
     layer = Sdf.Layer.FindOrOpen(str(path))
@@ -282,3 +315,24 @@ def test_a_file_changed_after_the_check_is_refused(tmp_path: Path) -> None:
     with pytest.raises(UsdError, match="changed since this generation started"):
         copy_user_room(resolved.rooms.files[0], resolved, tmp_path / "scene")
     assert not (tmp_path / "scene").exists()
+
+
+def test_implausible_sizes_can_be_allowed_in_rooms(tmp_path: Path) -> None:
+    write_user_room(tmp_path / "big.usda", up="Y", mpu=0.01, gprims=True)
+    stage = Usd.Stage.Open(str(tmp_path / "big.usda"))
+    UsdGeom.SetStageMetersPerUnit(stage, 1.0)  # centimetres read as metres: a 400 m room
+    stage.GetRootLayer().Save()
+    config = tmp_path / "big.toml"
+    config.write_text('[rooms]\nfiles = ["big.usda"]\n')
+    with pytest.raises(UsdError, match=r"raise \[rooms\] max_room_size \(now 30\)"):
+        resolve_user_rooms(load_config(config))
+    config.write_text('[rooms]\nfiles = ["big.usda"]\nmax_room_size = 500.0\n')
+    with pytest.raises(UsdError, match=r"/Room/Fridge \(Fridge\) measures 70 x 80 x 180 m"):
+        resolve_user_rooms(load_config(config))
+    config.write_text('[rooms]\nfiles = ["big.usda"]\nmax_room_size = 500\nmax_object_size = 200\n')
+    resolved = resolve_user_rooms(load_config(config))
+    assert config_to_dict(resolved.rooms)["max_room_size"] == 500.0  # recorded when set
+    # left at their defaults, the limits stay out of the manifest: its bytes do not change
+    assert "max_room_size" not in config_to_dict(RoomsConfig())
+    with pytest.raises(ConfigError, match="rooms.max_object_size must be a positive number"):
+        RoomsConfig(max_object_size=float("nan"))

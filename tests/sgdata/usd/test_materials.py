@@ -13,9 +13,16 @@ from pxr import Sdf, Usd, UsdGeom, UsdShade
 
 from sgdata.scene_files import layout_file, room_file
 from sgdata.usd.geometry import read_geometry
-from sgdata.usd.looks import LIGHT_INTENSITY, LIGHT_TEMPERATURE, LOOK_TINT, LOOK_VARIANT
-from sgdata.usd.materials import LOOKS, PART_FAMILY
-from sgdata.usd.room_io import OBJECTS, STRUCTURE
+from sgdata.usd.materials import PART_FAMILY
+from sgdata.usd.prims import (
+    LIGHT_INTENSITY,
+    LIGHT_TEMPERATURE,
+    LOOK_TINT,
+    LOOK_VARIANT,
+    LOOKS,
+    OBJECTS,
+    STRUCTURE,
+)
 from sgdata.usd.scene_dirs import write_layouts, write_rooms
 from sgdata.usd.stage import open_stage, validate_stage
 from sgdata.world.appearance import AppearanceConfig

@@ -15,7 +15,7 @@ import pyarrow.compute as pc
 import pyarrow.parquet as pq
 import pytest
 
-from sgdata.dataset import read_manifest, write_manifest, write_parquet
+from sgdata.dataset import Dataset, read_manifest, write_manifest, write_parquet
 from sgdata.errors import DatasetError
 from sgdata.validate import ValidationReport, validate_dataset
 
@@ -429,3 +429,38 @@ def test_a_shard_without_the_huggingface_metadata_is_reported(copy: Path) -> Non
     (problem,) = find(report, "tables.schema")
     assert problem.file == SHARD and "'huggingface'" in problem.message
     assert checks(report) == {"tables.schema"}
+
+
+def test_image_column_of_another_type(copy: Path) -> None:
+    # image bytes stored as text raised TypeError in the image checks (found by tests/fuzz)
+    table = pq.read_table(copy / SHARD)
+    at = table.schema.get_field_index("image")
+    texts = pa.array([str(v)[:20] for v in table.column("image").to_pylist()])
+    rewrite(copy, SHARD, table.set_column(at, "image", texts))
+    report = validate_dataset(copy)
+    assert any(p.field == "image" for p in find(report, "tables.schema"))
+
+
+# found by tests/fuzz: each raised a traceback (or a message of several lines) before its fix
+def test_a_manifest_that_is_not_utf8(copy: Path) -> None:
+    path = copy / "dataset.json"
+    path.write_bytes(b"\x84" + path.read_bytes()[1:])
+    with pytest.raises(DatasetError, match=r"dataset.json: not UTF-8 text \(invalid start byte"):
+        Dataset.open(copy)
+    assert checks(validate_dataset(copy, quick=True)) == {"manifest.json"}
+
+
+def test_relation_rules_of_the_wrong_shape(copy: Path) -> None:
+    edit_manifest(copy, lambda raw: raw["relation_rules"].update(containment_tolerance=None))
+    report = validate_dataset(copy, quick=True)
+    problems = find(report, "relations.recompute")  # one per split
+    assert problems and all("relation_rules is {" in p.message for p in problems)
+
+
+def test_an_unreadable_shard_is_one_line(copy: Path) -> None:
+    data = (copy / SHARD).read_bytes()
+    (copy / SHARD).write_bytes(data[:4] + bytes([data[4] ^ 0xFF]) + data[5:])
+    with pytest.raises(DatasetError) as raised:
+        split = SHARD.split("/")[1]
+        Dataset.open(copy).observations(split)
+    assert "not a readable Parquet file" in str(raised.value) and "\n" not in str(raised.value)

@@ -1,0 +1,25 @@
+"""Every fuzzed input surface, by name: add a surface's module here and it is fuzzed."""
+
+from __future__ import annotations
+
+from . import (
+    surface_configs,
+    surface_datasets,
+    surface_label_files,
+    surface_label_server,
+    surface_usd_rooms,
+)
+from .harness import Surface
+
+__all__ = ["SURFACES"]
+
+SURFACES: dict[str, Surface] = {
+    module.SURFACE.name: module.SURFACE
+    for module in (
+        surface_usd_rooms,
+        surface_configs,
+        surface_label_files,
+        surface_label_server,
+        surface_datasets,
+    )
+}
