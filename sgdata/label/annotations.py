@@ -145,6 +145,8 @@ class FieldReader:
     ) -> tuple[int, int, int, int]:
         """A pixel box from float edges: rounded, clipped to the photo, non-empty."""
         width, height = size
+        if not all(math.isfinite(x) for x in (u1, v1, u2, v2)):
+            raise self.fail(where, f"finite box edges, not {[u1, v1, u2, v2]}")
         edges = [round(u1), round(v1), round(u2), round(v2)]
         lo = [0, 0, 0, 0]
         hi = [width, height, width, height]

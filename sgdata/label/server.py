@@ -202,8 +202,8 @@ def create_app(
         body = await _read_body(request)
         try:
             raw = json.loads(body)
-        except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-            raise HTTPException(400, f"malformed JSON ({exc})") from None
+        except ValueError as exc:  # bad JSON, bad UTF-8, an integer of over 4,300 digits
+            raise HTTPException(400, f"malformed JSON ({str(exc)[:200]})") from None
         except RecursionError:
             raise HTTPException(400, "malformed JSON (nested too deeply)") from None
         try:

@@ -126,11 +126,13 @@ def _corrupt_image(path: Path, row: int, edit: str, at: int) -> None:
         return
     images = table.column("image").to_pylist()
     k = row % len(images)
-    data = images[k] or b""
+    stored = images[k]  # format 2: the Hugging Face Image struct; 1.x: the bytes
+    data = (stored.get("bytes") if isinstance(stored, dict) else stored) or b""
     at = at % max(len(data), 1)
-    images[k] = {"truncate": data[:at], "empty": b""}.get(
+    data = {"truncate": data[:at], "empty": b""}.get(
         edit, data[:at] + b"\x00garbage" + data[at + 8 :]
     )
+    images[k] = {"bytes": data, "path": None} if isinstance(stored, dict) else data
     index = table.schema.get_field_index("image")
     table = table.set_column(index, "image", pa.array(images, table.schema.field("image").type))
     pq.write_table(table, path)
