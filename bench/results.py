@@ -96,11 +96,21 @@ def run(args: argparse.Namespace) -> None:
                 budget_s=args.budget,
                 announce=print,
                 tag=step,
+                batches=_recorded_batches(runs),
             )
         elif step == "noise":
             noise_step(args.data, runs)
         else:
             raise SystemExit(f"unknown step {step!r}: {', '.join(COMPARISONS)} or noise")
+
+
+def _recorded_batches(runs: Path) -> dict[str, int]:
+    """Each trained network's batches per epoch, as the comparisons so far recorded them."""
+    out: dict[str, int] = {}
+    for path in sorted(runs.glob("selection-*.json")):
+        for m in json.loads(path.read_text())["models"]:
+            out.setdefault(m["trained"], m["batches_per_epoch"])
+    return out
 
 
 def noise_step(data: Path, runs: Path, grid: tuple[tuple[float, float], ...] = NOISE_GRID) -> None:

@@ -126,6 +126,7 @@ def compare_models(
     announce: Callable[[str], None] | None = None,
     on_selected: Callable[[Path], None] | None = None,
     tag: str = "",
+    batches: dict[str, int] | None = None,
 ) -> dict[str, Any]:
     """Select on val, test once; write ``out/selection.json`` then ``out/comparison.{json,md}``.
 
@@ -141,6 +142,9 @@ def compare_models(
             is read.
         tag: names this comparison's files (``selection-<tag>.json``, ...), so comparisons of
             different model sets can share one ``out`` and its runs.
+        batches: batches per epoch by trained network, as an earlier comparison on ``out``
+            recorded them (a calibration is timed, so a second one may differ by a batch and
+            the runs would not resume); the others are calibrated to ``budget_s``.
 
     Raises:
         ModelError: no model or no seed named, or a bad spec.
@@ -150,11 +154,11 @@ def compare_models(
     say = announce or (lambda _text: None)
     base = load_preset(preset) if isinstance(preset, str) else preset
     specs = [model_spec(name, base) for name in models]  # refuse a bad spec before work
-    batches: dict[str, int] = {}
+    batches = dict(batches or {})
     chosen = []
     for spec in specs:
         config = spec.config
-        if budget_s is not None:
+        if budget_s is not None or spec.trained in batches:
             if spec.trained not in batches:
                 batches[spec.trained] = calibrate_batches(config, data, budget_s)
                 filled = f"{batches[spec.trained]} batches per epoch fill {budget_s:.0f} s"
