@@ -21,6 +21,28 @@ TINY_LOCALIZER = TrainConfig().replace(
 )
 
 
+# SeanNet in seconds: ResNet-18 at 64 px, an 8 x 8 layout pathway, one batch of four triplets.
+TINY_SEANNET = TrainConfig().replace(
+    depth=18,
+    image_size=64,
+    roi_size=4,
+    visual_features="c5",
+    embed_dim=64,
+    layout_grid=8,
+    layout_sketch=0,
+    epochs=1,
+    batch_size=4,
+    max_train_batches=1,
+    num_workers=0,
+)
+
+
+@pytest.fixture
+def tiny_seannet() -> TrainConfig:
+    """A SeanNet training config that runs in seconds on the CPU."""
+    return TINY_SEANNET
+
+
 @pytest.fixture(scope="session")
 def localizer_run(tmp_path_factory: pytest.TempPathFactory, mini_dataset: Path) -> Path:
     """A run directory (best.pt) trained on the mini dataset; no eval file, so no epsilon."""

@@ -13,27 +13,14 @@ from seannet.evaluation.eval import eval_file, evaluate_run
 from seannet.training.config import TrainConfig
 from seannet.training.train import train
 
-TINY_SEANNET = TrainConfig().replace(
-    depth=18,
-    image_size=64,
-    roi_size=4,
-    visual_features="c5",
-    embed_dim=64,
-    layout_grid=8,
-    layout_sketch=0,
-    epochs=1,
-    batch_size=4,
-    max_train_batches=1,
-    num_workers=0,
-)
 NOISE = BoxNoise(jitter=0.1, drop=0.25, spurious=0.5, seed=2)
 
 
 def test_box_noise_reaches_the_scene_graph_not_the_image(
-    tmp_path: Path, mini_dataset: Path, localizer_run: Path
+    tmp_path: Path, mini_dataset: Path, localizer_run: Path, tiny_seannet: TrainConfig
 ) -> None:
     run = tmp_path / "seannet"
-    train(TINY_SEANNET, mini_dataset, run)
+    train(tiny_seannet, mini_dataset, run)
     clean = evaluate_run(run, mini_dataset, split="test", out=tmp_path / "a")
     noisy = evaluate_run(run, mini_dataset, split="test", out=tmp_path / "a", noise=NOISE)
     assert noisy["noise"] == {"jitter": 0.1, "drop": 0.25, "spurious": 0.5, "seed": 2}

@@ -10,19 +10,6 @@ from seannet.evaluation.compare import compare_models
 from seannet.training.config import TrainConfig
 
 ROOT = Path(__file__).resolve().parents[3]
-TINY = TrainConfig().replace(
-    depth=18,
-    image_size=64,
-    roi_size=4,
-    visual_features="c5",
-    embed_dim=64,
-    layout_grid=8,
-    layout_sketch=0,
-    epochs=1,
-    batch_size=4,
-    max_train_batches=1,
-    num_workers=0,
-)
 
 
 def _results_script():  # noqa: ANN202
@@ -32,14 +19,16 @@ def _results_script():  # noqa: ANN202
     return module
 
 
-def test_tables_are_the_runs_figures(tmp_path: Path, mini_dataset: Path) -> None:
+def test_tables_are_the_runs_figures(
+    tmp_path: Path, mini_dataset: Path, tiny_seannet: TrainConfig
+) -> None:
     results = _results_script()
     runs = tmp_path / "runs"
     head = compare_models(
         mini_dataset,
         runs,
         results.HEADLINE,
-        preset=TINY,
+        preset=tiny_seannet,
         seeds=(0, 1),
         lrs=(0.01,),  # one lr: the selection is compare's own test
         tag="headline",
