@@ -413,10 +413,20 @@ def tables(runs: Path) -> str:
             "",
             *_comparison_tables(json.loads(ablations.read_text())),
         ]
+    missing = (
+        []
+        if ablations.exists()
+        else [
+            "- The ablations (image branch alone, the paper's graph branch, graph-only) under the "
+            "same selection: `python bench/results.py run DATA RUNS --steps ablations` (about 45 "
+            "min of training on two CPU cores); not run for this set."
+        ]
+    )
     out += [
         "",
         "## Not measured in this set of runs",
         "",
+        *missing,
         *NOT_MEASURED,
         "",
         "Older figures (data of earlier generators, selection partly on test) are kept, dated "
