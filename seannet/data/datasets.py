@@ -533,6 +533,11 @@ class ObservationDataset(TorchDataset):
         """Observation ids in item order."""
         return list(self._store.obs_ids)
 
+    @property
+    def num_slots(self) -> int:
+        """M, the dataset's GCN node slots."""
+        return self._store.num_slots
+
     def slot_boxes(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Every view's objects as the model sees them (noise included), in item order:
         ``(offsets (N + 1,), slots (K,), boxes (K, 4))``; view v's are ``offsets[v]:[v + 1]``

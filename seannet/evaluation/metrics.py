@@ -30,7 +30,6 @@ from seannet.data.datasets import (
     ObservationDataset,
     TripletDataset,
     collate_views,
-    open_dataset,
 )
 from seannet.model.loss import similarity
 from seannet.training.config import TrainConfig
@@ -113,7 +112,7 @@ def embed_split(
         grid_j=np.array(meta["grid_j"]),
         heading=np.array(meta["heading"]),
         slot_boxes=dataset.slot_boxes(),
-        num_slots=int(open_dataset(data).manifest.num_slots),
+        num_slots=dataset.num_slots,
     )
 
 
