@@ -35,7 +35,7 @@ sys.path.insert(0, str(ROOT))
 
 from seannet.data.box_noise import BoxNoise  # noqa: E402
 from seannet.evaluation.compare import compare_models  # noqa: E402
-from seannet.evaluation.eval import eval_file, evaluate_run  # noqa: E402
+from seannet.evaluation.eval import eval_file, evaluate_run, scene_term  # noqa: E402
 from sgdata.dataset.rows import sha256_file  # noqa: E402
 from sgdata.fileio import atomic_write_text  # noqa: E402
 
@@ -118,7 +118,7 @@ def noise_step(data: Path, runs: Path, grid: tuple[tuple[float, float], ...] = N
     selection = json.loads((runs / "selection-headline.json").read_text())
     chosen = {m["model"]: m["runs"] for m in selection["models"]}
     for model in NOISE_MODELS:
-        boxes = model.endswith("+boxes")
+        boxes = scene_term(model)
         for jitter, drop in grid:
             noise = BoxNoise(jitter=jitter, drop=drop)
             seeds = chosen[model] if (jitter, drop) == AIM else chosen[model][:1]
@@ -246,7 +246,7 @@ def _noise_table(runs: Path, result: dict[str, Any]) -> list[str]:
     for model in NOISE_MODELS:
         if model not in chosen:
             continue
-        boxes = model.endswith("+boxes")
+        boxes = scene_term(model)
         cells, at = [], {}
         for jitter, drop in grid:
             noise = BoxNoise(jitter=jitter, drop=drop)
@@ -268,7 +268,7 @@ def _noise_table(runs: Path, result: dict[str, Any]) -> list[str]:
 def _aim_losses(runs: Path, result: dict[str, Any], model: str) -> list[float]:
     """Per seed: clean test accuracy minus accuracy at the aim's noise (seeds that have it)."""
     entry = next(e for e in result["models"] if e["model"] == model)
-    noise, boxes = BoxNoise(jitter=AIM[0], drop=AIM[1]), model.endswith("+boxes")
+    noise, boxes = BoxNoise(jitter=AIM[0], drop=AIM[1]), scene_term(model)
     out = []
     for r in entry["runs"]:
         path = eval_file(Path(r["run"]), "test", boxes=boxes, noise=noise)

@@ -106,6 +106,13 @@ def evaluate(
             "--boxes/--no-boxes", help="Score S + lambda * box overlap, lambda chosen on val."
         ),
     ] = False,
+    box_kernel: Annotated[
+        bool,
+        typer.Option(
+            "--box-kernel",
+            help="Score S + lambda * a box kernel learned on train, lambda chosen on val.",
+        ),
+    ] = False,
     box_noise: Annotated[
         float, typer.Option(help="S: box corners jittered by S x box size (normal std).")
     ] = 0.0,
@@ -116,13 +123,17 @@ def evaluate(
     noise_seed: Annotated[int, typer.Option(help="Seed of the box noise.")] = 0,
 ) -> None:
     """Triplet accuracy (overall, per room, per tier), similarity heat maps, threshold;
-    optionally with the box overlap (--boxes) or under labeler / detector box noise."""
+    optionally with the box overlap (--boxes) or the learned box kernel (--box-kernel), or
+    under labeler / detector box noise."""
     from seannet.data.box_noise import BoxNoise
     from seannet.evaluation.eval import eval_file, evaluate_run
 
+    if boxes and box_kernel:
+        raise typer.BadParameter("give --boxes or --box-kernel, not both")
+    term = "+boxes" if boxes else "+box-kernel" if box_kernel else ""
     noise = BoxNoise(jitter=box_noise, drop=drop, spurious=spurious, seed=noise_seed)
-    evaluate_run(run, data, split=split, boxes=boxes, noise=noise)
-    written = eval_file(run, split, boxes=boxes, noise=noise)
+    evaluate_run(run, data, split=split, boxes=term, noise=noise)
+    written = eval_file(run, split, boxes=term, noise=noise)
     console.print(written.with_suffix(".md").read_text())
     console.print(f"wrote {written}")
 
@@ -134,8 +145,8 @@ def compare(
     models: Annotated[
         str,
         typer.Option(
-            help="Comma-separated specs NAME[@lite0][+imagenet][+boxes]: seannet, "
-            "seannet-graph, resnet18, resnet18+boxes, seannet@lite0+imagenet, ..."
+            help="Comma-separated specs NAME[@lite0][+imagenet][+boxes|+box-kernel]: seannet, "
+            "seannet-graph, resnet18, resnet18+boxes, seannet+box-kernel, seannet@lite0+imagenet"
         ),
     ] = "seannet,resnet18",
     preset: Annotated[str, typer.Option(help="cpu | gpu | paper")] = "cpu",

@@ -9,7 +9,7 @@ The protocol (DESIGN §12), in the order it runs:
 2. **Selection, on val only.** For each learning rate of ``lrs``, seed 0 is trained and its
    best epoch (per-epoch val) is evaluated on the *whole* val split; the lr with the best val
    accuracy is chosen (ties: the smaller), and the other seeds are trained at it. A
-   ``+boxes`` spec chooses its lambda on val in the same evaluation.
+   ``+boxes`` or ``+box-kernel`` spec chooses its lambda on val in the same evaluation.
 3. ``selection.json`` is written: each model's chosen lr, its val accuracy by lr, its runs.
    No test row has been read until then (``on_selected`` is called at that point).
 4. **Test, once.** Each chosen run is evaluated on the test split.
@@ -17,12 +17,13 @@ The protocol (DESIGN §12), in the order it runs:
    t-interval; for the first model minus each other, the paired two-level bootstrap and
    Welch's seed-level interval (:mod:`seannet.evaluation.intervals`).
 
-A model is named by a spec ``NAME[@lite0][+imagenet][+boxes]``: ``NAME`` a model or ablation
-(``seannet``, ``seannet-graph``, ``resnet18``, ``efficientnet_lite0``, ...), ``@lite0`` puts
-SeanNet on the EfficientNet-Lite0 image network, ``+imagenet`` starts that network from the
-ImageNet weights that install offline (the `lite` extra), ``+boxes`` adds the hand-made box
-overlap to the similarity (:mod:`seannet.evaluation.box_overlap`; its runs are ``NAME``'s:
-``resnet18`` and ``resnet18+boxes`` train once).
+A model is named by a spec ``NAME[@lite0][+imagenet][+boxes|+box-kernel]``: ``NAME`` a model
+or ablation (``seannet``, ``seannet-graph``, ``resnet18``, ``efficientnet_lite0``, ...),
+``@lite0`` puts SeanNet on the EfficientNet-Lite0 image network, ``+imagenet`` starts that
+network from the ImageNet weights that install offline (the `lite` extra), ``+boxes`` adds the
+hand-made box overlap to the similarity (:mod:`seannet.evaluation.box_overlap`) and
+``+box-kernel`` the box kernel learned on train (:mod:`seannet.evaluation.box_kernel`); their
+runs are ``NAME``'s: ``resnet18``, ``resnet18+boxes`` and ``resnet18+box-kernel`` train once.
 """
 
 from __future__ import annotations
@@ -42,7 +43,7 @@ from torch.utils.data import DataLoader
 
 from seannet.data.datasets import ImageTransform, TripletDataset, collate_triplets
 from seannet.errors import ModelError
-from seannet.evaluation.eval import evaluate_run
+from seannet.evaluation.eval import evaluate_run, scene_term
 from seannet.evaluation.intervals import (
     per_room_matrix,
     t_interval,
@@ -74,7 +75,6 @@ __all__ = [
 COMPARISON = "comparison"  # comparison.json and comparison.md under the output directory
 SELECTION = "selection.json"  # every choice, written before any test row is read
 _CALIBRATION_STEPS = 3  # timed training steps (after one warm-up) per model
-_BOXES = "+boxes"
 _IMAGENET = "+imagenet"
 
 
@@ -86,18 +86,18 @@ class ModelSpec:
     trained: str  # the trained network's spec (its run directory), e.g. "resnet18"
     config: TrainConfig
     pretrained: Path | None
-    boxes: bool
+    boxes: str  # the scene term added to the similarity (eval.SCENE_TERMS), or ""
 
 
 def model_spec(spec: str, base: TrainConfig) -> ModelSpec:
-    """What a spec ``NAME[@lite0][+imagenet][+boxes]`` names.
+    """What a spec ``NAME[@lite0][+imagenet][+boxes|+box-kernel]`` names.
 
     Raises:
         ModelError: ``@`` names another image network, or ``+imagenet`` asks for weights the
             spec's image network has none of offline (only EfficientNet-Lite0 has).
     """
-    boxes = spec.endswith(_BOXES)
-    trained = spec.removesuffix(_BOXES)
+    boxes = scene_term(spec)
+    trained = spec.removesuffix(boxes)
     imagenet = trained.endswith(_IMAGENET)
     name, _, network = trained.removesuffix(_IMAGENET).partition("@")
     config = base.replace(model=name)

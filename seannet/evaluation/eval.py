@@ -12,10 +12,12 @@ import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
 from seannet.data.box_noise import BoxNoise
-from seannet.data.datasets import ImageTransform, TripletDataset, open_dataset
+from seannet.data.datasets import ImageTransform, ObservationDataset, TripletDataset, open_dataset
 from seannet.data.moved import moved_objects
 from seannet.errors import DataError
+from seannet.evaluation.box_kernel import SlotPairs, fit_box_kernel, slot_pairs
 from seannet.evaluation.box_overlap import SlotBoxes, choose_box_weight
+from seannet.evaluation.embedding_cache import cached_embeddings
 from seannet.evaluation.metrics import (
     MAX_OFFSET,
     Embeddings,
@@ -34,7 +36,18 @@ from seannet.training.runs import MODEL_KEYS, restore_run
 from sgdata.errors import SgdataError
 from sgdata.fileio import atomic_write_text, save_png
 
-__all__ = ["draw_heatmap", "eval_file", "evaluate_run"]
+__all__ = ["SCENE_TERMS", "draw_heatmap", "eval_file", "evaluate_run", "scene_term"]
+
+# what a model spec may add to its image similarity, ``S + lambda * S_scene``, lambda on val
+SCENE_TERMS = {
+    "+boxes": "the hand-made box overlap (seannet.evaluation.box_overlap)",
+    "+box-kernel": "the box kernel learned on the train triplets (seannet.evaluation.box_kernel)",
+}
+
+
+def scene_term(spec: str) -> str:
+    """The scene term a model spec ends with: a key of :data:`SCENE_TERMS`, or ``""``."""
+    return next((term for term in SCENE_TERMS if spec.endswith(term)), "")
 
 
 def evaluate_run(
@@ -43,7 +56,7 @@ def evaluate_run(
     *,
     split: str = "test",
     out: Path | None = None,
-    boxes: bool = False,
+    boxes: str = "",
     noise: BoxNoise | None = None,
 ) -> dict:
     """Evaluate ``run/best.pt`` on ``split`` of ``data``; writes ``eval_<split><tag>.*`` files.
@@ -52,43 +65,50 @@ def evaluate_run(
     the same box noise as ``split``; the split evaluated only gives figures.
 
     Args:
-        boxes: score pairs ``S + lambda * S_box`` (:mod:`seannet.evaluation.box_overlap`),
-            lambda chosen on val: ``MODEL+boxes``. Tag ``+boxes``.
+        boxes: a scene term of :data:`SCENE_TERMS` (``""``: none): score pairs
+            ``S + lambda * S_scene``, lambda chosen on val (``+boxes``: the hand-made overlap;
+            ``+box-kernel``: the kernel learned on train). Tagged with the term's name.
         noise: evaluate with the boxes a labeler or detector would give (:class:`BoxNoise`).
             Tag ``_S<jitter>-P<drop>-Q<spurious>``.
 
     Raises:
         CheckpointError: no checkpoint, or it was trained on another dataset.
-        DataError: the dataset or split is missing; ``boxes`` on a dataset with no val split.
+        DataError: the dataset or split is missing; ``boxes`` on a dataset with no val split,
+            ``+box-kernel`` on one with no train split.
     """
+    if boxes and boxes not in SCENE_TERMS:
+        raise ValueError(f"boxes={boxes!r}: expected one of {', '.join(SCENE_TERMS)} or ''")
     out = out or run
     ds = open_dataset(data)
     # photos: another dataset by design, but the same vocabulary
     restored = restore_run(run, data, keys=MODEL_KEYS if _all_real(ds, split) else None)
     config, model, device, state = restored.config, restored.model, restored.device, restored.state
-    evaluated = embed_split(model, config, data, split, device, noise=noise)
+
+    def embedded(name: str) -> Embeddings:
+        compute = lambda: embed_split(model, config, data, name, device, noise=noise)  # noqa: E731
+        return cached_embeddings(run, data, name, noise, compute)
+
+    evaluated = embedded(split)
     transform = ImageTransform.for_model(config.model.image_size, config.model.image_family)
     triplets = TripletDataset(data, split, transform=transform)
     s_ap, s_an = triplet_similarities(evaluated, triplets)
     val = None
     if "val" in ds.splits:
-        val = (
-            evaluated
-            if split == "val"
-            else embed_split(model, config, data, "val", device, noise=noise)
-        )
-    name, tag = config.model.name + ("+boxes" if boxes else ""), _tag(boxes, noise)
+        val = evaluated if split == "val" else embedded("val")
+    name, tag = config.model.name + boxes, _tag(boxes, noise)
     choices: dict[str, Any] = {}
     if boxes:
         if val is None:
-            raise DataError(f"{data}: +boxes chooses lambda on the val split, and there is none")
+            raise DataError(f"{data}: {boxes} chooses lambda on the val split, and there is none")
         val_triplets = (
             triplets if split == "val" else TripletDataset(data, "val", transform=transform)
         )
+        scene = _SceneScores(boxes, data, noise)
+        choices.update(scene.fit)
         v_ap, v_an = triplet_similarities(val, val_triplets)
-        b_ap, b_an = _box_overlaps(val, val_triplets)
+        b_ap, b_an = scene.triplets(val, val_triplets)
         weight, by_weight = choose_box_weight(v_ap, v_an, b_ap, b_an)
-        o_ap, o_an = _box_overlaps(evaluated, triplets)
+        o_ap, o_an = scene.triplets(evaluated, triplets)
         s_ap, s_an = s_ap + weight * o_ap, s_an + weight * o_an
         choices["box_weight"] = {"lambda": weight, "val_accuracy_by_lambda": by_weight}
     metrics = triplet_metrics(triplets, s_ap, s_an)
@@ -133,28 +153,54 @@ def evaluate_run(
     return result
 
 
-def eval_file(run: Path, split: str, *, boxes: bool = False, noise: BoxNoise | None = None) -> Path:
+def eval_file(run: Path, split: str, *, boxes: str = "", noise: BoxNoise | None = None) -> Path:
     """Where :func:`evaluate_run` writes its JSON for these options."""
     return run / f"eval_{split}{_tag(boxes, noise)}.json"
 
 
-def _tag(boxes: bool, noise: BoxNoise | None) -> str:
-    tag = "+boxes" if boxes else ""
+def _tag(boxes: str, noise: BoxNoise | None) -> str:
+    tag = boxes
     if noise is not None and noise.active:
         tag += f"_{noise.label()}"
     return tag
 
 
-def _box_overlaps(
-    embeddings: Embeddings, triplets: TripletDataset
-) -> tuple[np.ndarray, np.ndarray]:
-    """S_box(A, P) and S_box(A, N) of every triplet, from the boxes the model saw."""
-    assert embeddings.slot_boxes is not None  # embed_split always fills it
-    slot_boxes = SlotBoxes(embeddings.obs_ids, *embeddings.slot_boxes, embeddings.num_slots)
-    anchors, positives, negatives = (
-        zip(*triplets.obs, strict=True) if triplets.obs else ((), (), ())
-    )
-    return slot_boxes.overlap(anchors, positives), slot_boxes.overlap(anchors, negatives)
+class _SceneScores:
+    """``S_scene(A, P)`` and ``S_scene(A, N)`` of triplets, from the boxes the model saw:
+    the hand-made overlap, or the kernel fit on the train triplets' boxes (same noise)."""
+
+    def __init__(self, term: str, data: Path, noise: BoxNoise | None) -> None:
+        self.kernel = None
+        self.fit: dict[str, Any] = {}
+        if term == "+box-kernel":
+            ds = open_dataset(data)
+            if "train" not in ds.splits:
+                raise DataError(f"{data}: +box-kernel learns on the train split, and there is none")
+            views = ObservationDataset(data, "train", noise=noise)
+            boxes = SlotBoxes(views.obs_ids, *views.slot_boxes(), views.num_slots)
+            positive, negative = self._pairs(boxes, TripletDataset(data, "train").obs)
+            self.kernel, accuracy = fit_box_kernel(positive, negative, views.num_slots)
+            self.fit = {
+                "box_kernel": {"train_triplets": positive.pairs, "train_accuracy": accuracy}
+            }
+
+    @staticmethod
+    def _pairs(boxes: SlotBoxes, obs: list[tuple[str, str, str]]) -> tuple[SlotPairs, SlotPairs]:
+        anchors, positives, negatives = zip(*obs, strict=True) if obs else ((), (), ())
+        return slot_pairs(boxes, anchors, positives), slot_pairs(boxes, anchors, negatives)
+
+    def triplets(
+        self, embeddings: Embeddings, triplets: TripletDataset
+    ) -> tuple[np.ndarray, np.ndarray]:
+        assert embeddings.slot_boxes is not None  # embed_split always fills it
+        boxes = SlotBoxes(embeddings.obs_ids, *embeddings.slot_boxes, embeddings.num_slots)
+        if self.kernel is None:
+            anchors, positives, negatives = (
+                zip(*triplets.obs, strict=True) if triplets.obs else ((), (), ())
+            )
+            return boxes.overlap(anchors, positives), boxes.overlap(anchors, negatives)
+        positive, negative = self._pairs(boxes, triplets.obs)
+        return self.kernel.score(positive), self.kernel.score(negative)
 
 
 def _all_real(ds, split: str) -> bool:  # noqa: ANN001

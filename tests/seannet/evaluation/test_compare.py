@@ -116,12 +116,13 @@ def test_model_specs_name_network_and_imagenet_init() -> None:
         Path(LITE0_WEIGHTS),
     )
     assert model_spec("resnet18", TINY).config.model.backbone == "resnet"
-    boxes = model_spec("resnet18+boxes", TINY)
-    assert (boxes.trained, boxes.boxes, boxes.config) == (
-        "resnet18",
-        True,
-        model_spec("resnet18", TINY).config,
-    )
+    for term in ("+boxes", "+box-kernel"):
+        boxes = model_spec(f"seannet@lite0{term}", TINY)
+        assert (boxes.trained, boxes.boxes, boxes.config) == (
+            "seannet@lite0",
+            term,
+            model_spec("seannet@lite0", TINY).config,
+        )
 
 
 @pytest.mark.parametrize(

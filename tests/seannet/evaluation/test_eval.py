@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -40,11 +41,13 @@ def test_boxes_choose_lambda_on_val_and_write_their_own_file(
 ) -> None:
     out = tmp_path / "eval"
     plain = evaluate_run(localizer_run, mini_dataset, split="test", out=out)
-    boxed = evaluate_run(localizer_run, mini_dataset, split="test", out=out, boxes=True)
+    boxed = evaluate_run(localizer_run, mini_dataset, split="test", out=out, boxes="+boxes")
     assert boxed["model"] == "resnet18+boxes" and plain["model"] == "resnet18"
-    saved = json.loads(eval_file(out, "test", boxes=True).read_text())
+    saved = json.loads(eval_file(out, "test", boxes="+boxes").read_text())
     weight = saved["box_weight"]
-    val = evaluate_run(localizer_run, mini_dataset, split="val", out=tmp_path / "val", boxes=True)
+    val = evaluate_run(
+        localizer_run, mini_dataset, split="val", out=tmp_path / "val", boxes="+boxes"
+    )
     # lambda is what the val triplets chose, whichever split is evaluated
     assert weight == val["box_weight"]
     by = weight["val_accuracy_by_lambda"]
@@ -52,13 +55,20 @@ def test_boxes_choose_lambda_on_val_and_write_their_own_file(
     assert json.loads(eval_file(out, "test").read_text())["accuracy"] == plain["accuracy"]
 
 
-def test_boxes_need_a_val_split(tmp_path: Path, mini_dataset: Path, localizer_run: Path) -> None:
+@pytest.mark.parametrize(("term", "split"), [("+boxes", "val"), ("+box-kernel", "train")])
+def test_boxes_need_the_split_they_learn_on(
+    tmp_path: Path, mini_dataset: Path, localizer_run: Path, term: str, split: str
+) -> None:
     import shutil
 
     data = tmp_path / "data"
     shutil.copytree(mini_dataset, data)
     manifest = json.loads((data / "dataset.json").read_text())
-    del manifest["splits"]["val"]
+    rooms = manifest["splits"].pop(split)
+    counts = manifest["counts"]
+    counts["rooms"] -= len(rooms)
+    for key in ("observations", "triplets", "tiers"):
+        del counts[key][split]
     (data / "dataset.json").write_text(json.dumps(manifest))
-    with pytest.raises(DataError):
-        evaluate_run(localizer_run, data, split="test", out=tmp_path / "x", boxes=True)
+    with pytest.raises(DataError, match=f"{re.escape(term)} .* the {split} split"):
+        evaluate_run(localizer_run, data, split="test", out=tmp_path / "x", boxes=term)
