@@ -52,3 +52,27 @@ def test_tables_are_the_runs_figures(
     noise_rows = [line for line in doc.splitlines() if "(n=2)" in line]
     assert len(noise_rows) == 2 and all("points |" in line for line in noise_rows)
     assert "## Ablations" not in doc  # not run: not printed
+    assert "## A learned scene term" not in doc
+    # the learned scene term: the headline's runs evaluated again, its section computed
+    kernel = compare_models(
+        mini_dataset,
+        runs,
+        results.KERNEL,
+        preset=tiny_seannet,
+        seeds=(0, 1),
+        lrs=(0.01,),
+        tag="kernel",
+    )
+    assert {Path(r["run"]).parent.parent.name for m in kernel["models"] for r in m["runs"]} == {
+        "seannet",
+        "resnet18",
+    }
+    (runs / "provenance-kernel.json").write_text(json.dumps(record))
+    doc = results.tables(runs)
+    assert "## A learned scene term" in doc
+    for entry in kernel["models"][1:]:
+        d = entry["difference_to_first"]
+        assert (
+            f"seannet+box-kernel minus {entry['model']}: {100 * d['mean']:+.1f} "
+            f"[{100 * d['low']:+.1f}, {100 * d['high']:+.1f}]"
+        ) in doc
