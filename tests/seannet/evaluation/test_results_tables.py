@@ -76,3 +76,11 @@ def test_tables_are_the_runs_figures(
             f"seannet+box-kernel minus {entry['model']}: {100 * d['mean']:+.1f} "
             f"[{100 * d['low']:+.1f}, {100 * d['high']:+.1f}]"
         ) in doc
+    # full-map recall: maps rendered at spacing 1, each model's figures from its localize file
+    results.full_map_step(mini_dataset, runs)
+    doc = results.tables(runs)
+    for model in results.FULL_MAP_MODELS:
+        found = json.loads((runs / "fullmap" / model / "seed0" / results.FULL_MAP).read_text())
+        assert found["queries"] > 0
+        row = f"| {model} | {found['queries']} | {100 * found['recall@1']:.1f} |"
+        assert row in doc
