@@ -70,6 +70,10 @@ def test_tables_are_the_runs_figures(
     (runs / "provenance-kernel.json").write_text(json.dumps(record))
     doc = results.tables(runs)
     assert "## A learned scene term" in doc
+    ours = kernel["models"][0]["summary"]["accuracy"]["mean"]
+    assert (
+        f"| seannet+box-kernel (the learned scene term, below) >= 90 % | {100 * ours:.1f} %" in doc
+    )
     for entry in kernel["models"][1:]:
         d = entry["difference_to_first"]
         assert (
