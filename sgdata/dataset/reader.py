@@ -58,8 +58,9 @@ def read_table(
             separately); otherwise a differing column is an error.
 
     Raises:
-        DatasetError: the file is missing, unreadable, lacks a column, or a column differs
-            from the schema (and does not cast, with ``cast``).
+        DatasetError: the file is missing, unreadable, lacks a column, holds a corrupt one
+            (text that is not UTF-8), or a column differs from the schema (and does not cast,
+            with ``cast``).
     """
     name = schema.metadata[b"name"].decode() if schema.metadata else "sgdata"
     if not path.is_file():
@@ -79,6 +80,14 @@ def read_table(
                 f"{path}: no column(s) {missing}; not a format {FORMAT_VERSION} {name} table"
             )
         table = pq.read_table(path, columns=[n for n in names if n not in added])
+        for n, column in zip(table.column_names, table.columns, strict=True):
+            try:  # Parquet reads text unchecked: a flipped byte is invalid UTF-8 much later
+                column.validate(full=True)
+            except pa.ArrowInvalid as exc:
+                raise DatasetError(
+                    f"{path}: column {n!r} is corrupt ({one_line(exc)}); copy the file again, "
+                    "or regenerate the dataset"
+                ) from None
         for n in names:
             if n not in added and is_image_field(schema.field(n)):
                 at = table.schema.get_field_index(n)

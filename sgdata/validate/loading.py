@@ -38,15 +38,15 @@ class SplitTables:
         return self.file_index[rows], self.file_row[rows]
 
 
-def read_table_as(path: Path, schema: pa.Schema, *, skip: tuple[str, ...] = ()) -> pa.Table | None:
-    """``path`` read and cast to ``schema`` (minus ``skip``); None when that is impossible
-    (the table checks report why)."""
+def read_table_as(path: Path, schema: pa.Schema, *, skip: tuple[str, ...] = ()) -> pa.Table | str:
+    """``path`` read and cast to ``schema`` (minus ``skip``); else why it cannot be (a column
+    that does not cast is reported by the schema check too, a corrupt one only here)."""
     try:
         return read_table(
             path, schema, columns=[n for n in schema.names if n not in skip], cast=True
         )
-    except DatasetError:
-        return None
+    except DatasetError as exc:
+        return str(exc).removeprefix(f"{path}: ")
 
 
 def column_numpy(table: pa.Table | pa.StructArray, name: str, fill: Any = None) -> np.ndarray:

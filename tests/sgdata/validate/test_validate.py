@@ -464,3 +464,20 @@ def test_an_unreadable_shard_is_one_line(copy: Path) -> None:
         split = SHARD.split("/")[1]
         Dataset.open(copy).observations(split)
     assert "not a readable Parquet file" in str(raised.value) and "\n" not in str(raised.value)
+
+
+def test_text_that_is_not_utf8_in_a_shard(copy: Path) -> None:
+    # a byte flipped in a shard's text ("synthetic" -> b"\x8cynthetic"): Parquet reads it without
+    # a check, then validate's ids check raised ArrowException and a reader's to_pylist() a
+    # UnicodeDecodeError (found by tests/fuzz)
+    table = pq.read_table(copy / SHARD)
+    at = table.schema.get_field_index("domain")
+    flipped = [b"\x8c" + v.encode()[1:] for v in table.column("domain").to_pylist()]
+    text = pa.array(flipped, pa.binary()).view(pa.string())
+    rewrite(copy, SHARD, table.set_column(at, table.schema.field("domain"), text))
+    with pytest.raises(DatasetError, match=r"column 'domain' .*UTF8") as raised:
+        Dataset.open(copy).observations(SHARD.split("/")[1])
+    assert "\n" not in str(raised.value)
+    report = validate_dataset(copy, quick=True)
+    (problem,) = find(report, "tables.schema")
+    assert problem.file == SHARD and "column 'domain'" in problem.message
