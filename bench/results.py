@@ -593,6 +593,9 @@ NOT_MEASURED = [
     "bench/results.py run DATA RUNS --steps fullmap`) ranks it among every sub-node.",
     "- The `paper` preset on a GPU (ResNet-50 at 224 px, the four paper baselines): no GPU "
     "was lent to this session.",
+    "- `+box-kernel` under box noise (the noise table holds the headline's models only), and "
+    "full-map recall with a scene term: maps hold embeddings only, and epsilon is chosen for "
+    "the embedding alone, so `localize` and `navigate` take no `+boxes` / `+box-kernel` yet.",
 ]
 
 
