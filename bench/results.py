@@ -333,16 +333,9 @@ def _reading(runs: Path, result: dict[str, Any]) -> list[str]:
         if name == "seannet":
             continue
         d = e["difference_to_first"]
-        verdict = (
-            "SeanNet is above it"
-            if d["low"] > 0
-            else "SeanNet is below it"
-            if d["high"] < 0
-            else "the two are not apart (the interval holds 0)"
-        )
         lines.append(
             f"- SeanNet minus {name}: {_span(d, True)} points on the same rooms (rooms × "
-            f"seeds): {verdict}."
+            f"seeds): {_verdict(d, 'SeanNet')}."
         )
     stds = ", ".join(
         f"{name} {100 * e['summary']['accuracy']['std']:.1f}" for name, e in by.items()
@@ -417,6 +410,15 @@ def _full_map_section(runs: Path) -> list[str]:
     return lines
 
 
+def _verdict(difference: dict[str, Any], first: str) -> str:
+    """What an interval of "first minus another" says."""
+    if difference["low"] > 0:
+        return f"{first} is above it"
+    if difference["high"] < 0:
+        return f"{first} is below it"
+    return "the two are not apart (the interval holds 0)"
+
+
 def _kernel_aims(runs: Path) -> list[str]:
     """The first two aims again for SeanNet with the learned kernel (a design chosen on val),
     against the hand-made baseline of the same comparison."""
@@ -438,16 +440,9 @@ def _kernel_reading(result: dict[str, Any]) -> list[str]:
     lines = []
     for e in result["models"][1:]:
         d = e["difference_to_first"]
-        verdict = (
-            "the kernel is above it"
-            if d["low"] > 0
-            else "the kernel is below it"
-            if d["high"] < 0
-            else "not apart (the interval holds 0)"
-        )
         lines.append(
             f"- {result['models'][0]['model']} minus {e['model']}: {_span(d, True)} points "
-            f"(rooms × seeds): {verdict}."
+            f"(rooms × seeds): {_verdict(d, result['models'][0]['model'])}."
         )
     return lines
 
