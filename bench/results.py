@@ -32,6 +32,7 @@ import json
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -419,6 +420,34 @@ def _verdict(difference: dict[str, Any], first: str) -> str:
     return "the two are not apart (the interval holds 0)"
 
 
+def _comparison_section(
+    runs: Path,
+    step: str,
+    title: str,
+    intro: str,
+    reading: Callable[[dict[str, Any]], list[str]] | None = None,
+) -> list[str]:
+    """A comparison step's section (nothing when the step was not run): title, what it asks,
+    its stamp, computed statements, its tables."""
+    path = runs / f"comparison-{step}.json"
+    if not path.exists():
+        return []
+    record = json.loads((runs / f"provenance-{step}.json").read_text())
+    result = json.loads(path.read_text())
+    said = [*reading(result), ""] if reading else []
+    return [
+        "",
+        f"## {title}",
+        "",
+        intro,
+        "",
+        _stamp(record),
+        "",
+        *said,
+        *_comparison_tables(result),
+    ]
+
+
 def _kernel_aims(runs: Path) -> list[str]:
     """The first two aims again for SeanNet with the learned kernel (a design chosen on val),
     against the hand-made baseline of the same comparison."""
@@ -508,56 +537,35 @@ def tables(runs: Path) -> str:
         *_noise_stamp(runs),
         *_noise_table(runs, head),
     ]
-    boxes = runs / "comparison-boxes.json"
-    if boxes.exists():
-        record = json.loads((runs / "provenance-boxes.json").read_text())
-        out += [
-            "",
-            "## SeanNet plus the hand-made overlap",
-            "",
-            "Whether the box overlap still adds to SeanNet (lambda chosen on val): if it does, "
-            "SeanNet's layout pathway has not learned what the boxes hold. Same runs as the "
-            "headline's SeanNet, evaluated again.",
-            "",
-            _stamp(record),
-            "",
-            *_comparison_tables(json.loads(boxes.read_text())),
-        ]
+    out += _comparison_section(
+        runs,
+        "boxes",
+        "SeanNet plus the hand-made overlap",
+        "Whether the box overlap still adds to SeanNet (lambda chosen on val): if it does, "
+        "SeanNet's layout pathway has not learned what the boxes hold. Same runs as the "
+        "headline's SeanNet, evaluated again.",
+    )
     out += _full_map_section(runs)
-    kernel = runs / "comparison-kernel.json"
-    if kernel.exists():
-        record = json.loads((runs / "provenance-kernel.json").read_text())
-        result = json.loads(kernel.read_text())
-        out += [
-            "",
-            "## A learned scene term: the box kernel",
-            "",
-            "`+box-kernel` scores `S + lambda * S_kernel`: the box overlap with a weight per "
-            "slot learned on the train triplets' boxes (a chair that moves counts less than a "
-            "fridge that does not; `seannet/evaluation/box_kernel.py`), lambda chosen on val "
-            "as for `+boxes`. The runs are the headline's, evaluated again.",
-            "",
-            _stamp(record),
-            "",
-            *_kernel_reading(result),
-            "",
-            *_comparison_tables(result),
-        ]
+    out += _comparison_section(
+        runs,
+        "kernel",
+        "A learned scene term: the box kernel",
+        "`+box-kernel` scores `S + lambda * S_kernel`: the box overlap with a weight per "
+        "slot learned on the train triplets' boxes (a chair that moves counts less than a "
+        "fridge that does not; `seannet/evaluation/box_kernel.py`), lambda chosen on val "
+        "as for `+boxes`. The runs are those of the headline and the `boxes` comparison, "
+        "evaluated again.",
+        reading=_kernel_reading,
+    )
+    out += _comparison_section(
+        runs,
+        "ablations",
+        "Ablations: what each branch adds, under the same selection",
+        "`seannet-image`: the image branch alone; `seannet-nolayout`: the paper's graph "
+        "branch (GCN pathways, no layout pathway); `seannet-graph`: no image vector in "
+        "the fusion. SeanNet's runs are the headline's.",
+    )
     ablations = runs / "comparison-ablations.json"
-    if ablations.exists():
-        record = json.loads((runs / "provenance-ablations.json").read_text())
-        out += [
-            "",
-            "## Ablations: what each branch adds, under the same selection",
-            "",
-            "`seannet-image`: the image branch alone; `seannet-nolayout`: the paper's graph "
-            "branch (GCN pathways, no layout pathway); `seannet-graph`: no image vector in "
-            "the fusion. SeanNet's runs are the headline's.",
-            "",
-            _stamp(record),
-            "",
-            *_comparison_tables(json.loads(ablations.read_text())),
-        ]
     missing = (
         []
         if ablations.exists()
