@@ -4,6 +4,8 @@
         [--pairs 20000] [--val-pairs 2000] [--image-size 96] [--epochs 10] [--episodes 20]
         [--workers 2] [--encoder resnet18] [--pretrained imagenet-lite0] [--cross-layout 0.5]
         [--jitter 0.2]
+    python bench/navigation.py variants DATA OUT [the run's pair options] [--subset 4800]
+        [--variant-epochs 3]
     python bench/navigation.py tables [OUT] [-o docs/navigation.md]
 
 ``run`` records what made the runs (commit, command, dataset manifest sha256 and format
@@ -11,6 +13,11 @@ version) in ``OUT/provenance.json``, trains the navigator into ``OUT/navigator``
 in ``OUT/navigator_pairs``; skipped once trained) and runs ``seannet navigate`` of every
 localizer on the test rooms under the paper's rule and ``--replan`` into ``OUT/navigate``
 (it resumes where a killed run stopped).
+
+``variants`` chooses the navigator on val before ``run``: each variant (fusion, ImageNet init,
+light jitter) is trained on the same subset of ``run``'s cached train pairs (``--subset``
+pairs spread over every train room) for ``--variant-epochs`` and scored on all its val pairs;
+``OUT/variants.json`` holds the table.
 
 ``tables`` rewrites the blocks of docs/navigation.md between ``<!-- bench/navigation.py: NAME
 -->`` and ``<!-- end NAME -->``: ``paper`` (the paper's Table II) always, ``measured`` from
@@ -25,6 +32,8 @@ import re
 import sys
 from pathlib import Path
 
+import numpy as np
+
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "bench"))
@@ -32,8 +41,12 @@ sys.path.insert(0, str(ROOT / "bench"))
 from results import provenance  # noqa: E402  (bench/results.py: one home for provenance)
 
 import seannet  # noqa: E402,F401  (imports torch's compiler stack first: see tests/conftest.py)
-from seannet.navigation.navigate import run_navigation  # noqa: E402
+from seannet.data.datasets import dataset_identity  # noqa: E402
+from seannet.data.live_views import LiveRooms  # noqa: E402
+from seannet.navigation.maps import MAP_META, derive_map, load_map, save_map  # noqa: E402
+from seannet.navigation.navigate import run_labels, run_navigation  # noqa: E402
 from seannet.navigation.navigator import NavigatorConfig  # noqa: E402
+from seannet.navigation.pairs import PairSet, render_pairs  # noqa: E402
 from seannet.navigation.tables import (  # noqa: E402
     RATE_HEADER,
     SPLIT_HEADER,
@@ -42,12 +55,26 @@ from seannet.navigation.tables import (  # noqa: E402
     read_results,
     time_rows,
 )
-from seannet.navigation.train_navigator import train_navigator  # noqa: E402
+from seannet.navigation.train_navigator import fit_navigator, train_navigator  # noqa: E402
 from seannet.training.runs import BEST, HISTORY, load_checkpoint  # noqa: E402
+from seannet.weights import LITE0_WEIGHTS  # noqa: E402
+from sgdata.dataset import Dataset  # noqa: E402
 from sgdata.fileio import atomic_write_text  # noqa: E402
 
 SPLIT = "test"
 PROVENANCE = "provenance.json"
+MAP_SPACING = 2  # the maps `navigate` builds (its default, the authors' spacing)
+VARIANTS = "variants.json"
+# navigator variants compared on val (name: config changes, ImageNet init)
+NAVIGATOR_VARIANTS = {
+    "resnet18, late fusion (siamese)": ({"fusion": "late"}, None),
+    "resnet18, early fusion": ({"fusion": "early"}, None),
+    "resnet18, early fusion, light jitter 0.2": ({"fusion": "early", "jitter": 0.2}, None),
+    "lite0 ImageNet, early fusion": (
+        {"fusion": "early", "encoder": "efficientnet_lite0"},
+        Path(LITE0_WEIGHTS),
+    ),
+}
 # The paper's Table II (§VI-B): success and failure rates in percent, N / A, over
 # 5,476 N and 204,136 A cases in 20 test rooms.
 PAPER_CASES = (5476, 204136)
@@ -60,11 +87,8 @@ PAPER_TABLE_II = {
 }
 
 
-def run(args: argparse.Namespace) -> None:
-    out: Path = args.out
-    out.mkdir(parents=True, exist_ok=True)
-    atomic_write_text(out / PROVENANCE, json.dumps(provenance(args.data, sys.argv), indent=2))
-    config = NavigatorConfig(
+def navigator_config(args: argparse.Namespace) -> NavigatorConfig:
+    return NavigatorConfig(
         encoder=args.encoder,
         image_size=args.image_size,
         epochs=args.epochs,
@@ -72,7 +96,19 @@ def run(args: argparse.Namespace) -> None:
         val_pairs=args.val_pairs,
         cross_layout=args.cross_layout,
         jitter=args.jitter,
+        fusion=args.fusion,
     )
+
+
+def run(args: argparse.Namespace) -> None:
+    out: Path = args.out
+    out.mkdir(parents=True, exist_ok=True)
+    atomic_write_text(out / PROVENANCE, json.dumps(provenance(args.data, sys.argv), indent=2))
+    config = navigator_config(args)
+    if args.full_maps:
+        if len(args.full_maps) != len(args.localizer):
+            raise SystemExit("give one --full-maps per --localizer, in the same order")
+        seed_maps(args.localizer, args.full_maps, args.data, out / "navigate" / "maps")
     navigator = out / "navigator"
     if not (navigator / BEST).is_file():
         cache = out / "navigator_pairs"
@@ -87,6 +123,92 @@ def run(args: argparse.Namespace) -> None:
         workers=args.workers,
         out=out / "navigate",
         progress=lambda text: print(text, flush=True),
+    )
+
+
+def seed_maps(localizers: list[Path], full_maps: list[Path], data: Path, maps: Path) -> None:
+    """Put into the navigation's map cache, for each localizer and test room, the map that
+    ``navigate`` would build, derived from that localizer's spacing-1 map (e.g. the full-map
+    recall's, bench/results.py): the same views and embeddings, not rendered again. A derived
+    map of another checkpoint is found stale by ``navigate`` and built anew."""
+    for label, source in zip(run_labels(localizers), full_maps, strict=True):
+        for room_id in Dataset.open(data).rooms(SPLIT):
+            target = maps / label / room_id
+            if not (target / MAP_META).is_file() and (source / room_id / MAP_META).is_file():
+                save_map(derive_map(load_map(source / room_id), MAP_SPACING), target)
+
+
+def variants(args: argparse.Namespace) -> None:
+    """Train each of :data:`NAVIGATOR_VARIANTS` on the same train subset; score on val."""
+    out: Path = args.out
+    base = navigator_config(args)
+    identity = dataset_identity(args.data)
+    with LiveRooms(args.data) as live:
+        train_set, val_set = (
+            render_pairs(live, split, count, base, cache=out / "navigator_pairs", identity=identity)
+            for split, count in (("train", base.train_pairs), ("val", base.val_pairs))
+        )
+    subset = _spread(train_set, args.subset)
+    rows = []
+    for name, (changes, pretrained) in NAVIGATOR_VARIANTS.items():
+        config = base.replace(epochs=args.variant_epochs, train_pairs=len(subset), **changes)
+        directory = out / "variants" / re.sub(r"[^a-z0-9]+", "-", name.lower()).strip("-")
+        history_file = directory / HISTORY
+        if not history_file.is_file():
+            fit_navigator(
+                config, subset, val_set, directory, identity=identity, pretrained=pretrained
+            )
+        history = json.loads(history_file.read_text())
+        best = max(history, key=lambda h: h["val_accuracy"])
+        rows.append(
+            {
+                "variant": name,
+                "config": config.to_dict(),
+                "best_epoch": best["epoch"],
+                "val_accuracy": best["val_accuracy"],
+                "val_by_action": best["val_by_action"],
+                "seconds_per_epoch": sum(h["seconds"] for h in history) / len(history),
+            }
+        )
+        print(f"{name}: val {100 * best['val_accuracy']:.1f} %", flush=True)
+    record = {
+        "provenance": provenance(args.data, sys.argv),
+        "train_pairs": len(subset),
+        "val_pairs": len(val_set),
+        "epochs": args.variant_epochs,
+        "variants": rows,
+    }
+    atomic_write_text(out / VARIANTS, json.dumps(record, indent=2))
+
+
+def _spread(pairs: PairSet, count: int) -> PairSet:
+    """``count`` pairs taken evenly over ``pairs`` (so over every room)."""
+    pick = np.linspace(0, len(pairs) - 1, num=min(count, len(pairs))).round().astype(int)
+    return PairSet(pairs.current[pick], pairs.goal[pick], pairs.labels[pick],
+                   pairs.poses[pick], pairs.rooms[pick])  # fmt: skip
+
+
+def variants_block(out: Path) -> str:
+    """The table of ``out/variants.json``."""
+    record = json.loads((out / VARIANTS).read_text())
+    made = record["provenance"]
+    actions = ("forward", "left", "right")
+    rows = [
+        [v["variant"], f"{100 * v['val_accuracy']:.1f}"]
+        + [f"{100 * v['val_by_action'][a][0]:.1f}" for a in actions]
+        + [str(v["best_epoch"] + 1), f"{v['seconds_per_epoch']:.0f}"]
+        for v in record["variants"]
+    ]
+    header = ["navigator", "val acc %", *(f"{a} %" for a in actions), "best epoch", "s / epoch"]
+    return "\n".join(
+        [
+            f"Made {made['started']} by commit `{made['commit'][:12]}` on `{made['data']}` "
+            f"(manifest sha256 `{made['manifest_sha256'][:16]}`): `{made['command']}`. Each "
+            f"variant trained on the same {record['train_pairs']:,} train pairs for "
+            f"{record['epochs']} epochs, scored on {record['val_pairs']:,} val pairs.",
+            "",
+            *_table(header, rows),
+        ]
     )
 
 
@@ -123,8 +245,8 @@ def measured_block(out: Path) -> str:
         f"`{made['command']}`.",
         "",
         f"Navigator: {best['train_pairs']:,} train pairs at {config['image_size']} px, "
-        f"{config['encoder']} ({init}), goals of another layout "
-        f"{100 * config.get('cross_layout', 0.0):.0f} %, light jitter ±"
+        f"{config['encoder']} ({init}, {config.get('fusion', 'late')} fusion), goals of "
+        f"another layout {100 * config.get('cross_layout', 0.0):.0f} %, light jitter ±"
         f"{100 * config.get('jitter', 0.0):.0f} %; best epoch {best['epoch'] + 1} of "
         f"{len(history)}, val accuracy "
         f"{100 * best['val_accuracy']:.1f} % on {best.get('val_pairs', 0):,} val pairs.",
@@ -172,36 +294,58 @@ def replace_block(text: str, name: str, body: str) -> str:
 
 
 def write_tables(out: Path | None, doc: Path) -> None:
-    """Rewrite ``doc``'s ``paper`` block, and its ``measured`` block from ``out`` if given."""
+    """Rewrite ``doc``'s ``paper`` block, and its ``measured`` (and ``variants``, where they
+    were compared) blocks from ``out`` if given."""
     text = replace_block(doc.read_text(), "paper", "\n".join(_table(RATE_HEADER, paper_rows())))
     if out is not None:
         text = replace_block(text, "measured", measured_block(out))
+        if (out / VARIANTS).is_file():
+            text = replace_block(text, "variants", variants_block(out))
     atomic_write_text(doc, text)
+
+
+def _pair_options(parser: argparse.ArgumentParser) -> None:
+    """What the rendered pairs depend on: the same for ``run`` and ``variants``."""
+    parser.add_argument("data", type=Path)
+    parser.add_argument("out", type=Path)
+    parser.add_argument("--pairs", type=int, default=20000)
+    parser.add_argument("--val-pairs", type=int, default=2000)
+    parser.add_argument("--image-size", type=int, default=96)
+    parser.add_argument("--cross-layout", type=float, default=0.0)
 
 
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="verb", required=True)
     go = sub.add_parser("run", help="make the runs")
-    go.add_argument("data", type=Path)
-    go.add_argument("out", type=Path)
+    choose = sub.add_parser("variants", help="compare navigator variants on val")
+    for verb in (go, choose):
+        _pair_options(verb)
     go.add_argument("--localizer", type=Path, action="append", required=True)
-    go.add_argument("--pairs", type=int, default=20000)
-    go.add_argument("--val-pairs", type=int, default=2000)
-    go.add_argument("--image-size", type=int, default=96)
     go.add_argument("--epochs", type=int, default=10)
     go.add_argument("--encoder", default="resnet18")
     go.add_argument("--pretrained", type=Path, help="ImageNet init, e.g. imagenet-lite0")
-    go.add_argument("--cross-layout", type=float, default=0.0)
     go.add_argument("--jitter", type=float, default=0.0)
+    go.add_argument("--fusion", choices=("early", "late"), default="early")
     go.add_argument("--episodes", type=int, default=20)
     go.add_argument("--workers", type=int, default=2)
+    go.add_argument(
+        "--full-maps",
+        type=Path,
+        action="append",
+        help="a spacing-1 map directory per --localizer (same order) to derive the maps from",
+    )
+    choose.add_argument("--subset", type=int, default=4800, help="train pairs per variant")
+    choose.add_argument("--variant-epochs", type=int, default=3)
+    choose.set_defaults(epochs=1, encoder="resnet18", jitter=0.0, fusion="early")
     tables = sub.add_parser("tables", help="write docs/navigation.md's tables")
     tables.add_argument("out", type=Path, nargs="?")
     tables.add_argument("-o", "--output", type=Path, default=ROOT / "docs" / "navigation.md")
     args = parser.parse_args(argv)
     if args.verb == "run":
         run(args)
+    elif args.verb == "variants":
+        variants(args)
     else:
         write_tables(args.out, args.output)
 

@@ -286,6 +286,9 @@ def train_navigator_command(
         float, typer.Option(help="Share of pairs whose goal view is of another layout.")
     ] = 0.0,
     jitter: Annotated[float, typer.Option(help="Brightness / contrast jitter, +- share.")] = 0.0,
+    fusion: Annotated[
+        str, typer.Option(help="early: the two views stacked as 6 channels; late: siamese.")
+    ] = "early",
 ) -> None:
     """Train the visual navigator (forward / left / right) on pairs rendered from the rooms."""
     from rich.progress import Progress
@@ -296,7 +299,7 @@ def train_navigator_command(
     config = NavigatorConfig(
         encoder=encoder, image_size=image_size, epochs=epochs, batch_size=batch_size,
         train_pairs=pairs, val_pairs=val_pairs, seed=seed, cross_layout=cross_layout,
-        jitter=jitter,
+        jitter=jitter, fusion=fusion,
     )  # fmt: skip
     with Progress(console=console, transient=True) as bar:
         task = bar.add_task("render pairs", total=None)

@@ -50,6 +50,7 @@ __all__ = [
     "build_maps",
     "check_map",
     "current_map",
+    "derive_map",
     "ensure_map",
     "load_map",
     "map_dirs",
@@ -247,6 +248,42 @@ def build_map(
         obs_ids=[obs_id(room_id, layout, *k) for k in keys],
         embeddings=embeddings,
         images=images,
+    )
+
+
+def derive_map(full: TopoMap, spacing: int) -> TopoMap:
+    """The map at ``spacing`` that :func:`build_map` would build, taken from ``full``, a map of
+    the same run, room and layout at spacing 1: its nodes are every reachable cell, so it
+    holds the reachable grid, and the sub-nodes kept need no render or embedding again.
+
+    Raises:
+        MapError: ``full`` is not a spacing-1 map, or no node is left.
+    """
+    if full.spacing != 1:
+        raise MapError(
+            f"map of {full.room_id}: spacing {full.spacing}; derive from a spacing-1 map"
+        )
+    reachable = np.zeros(tuple(full.meta["grid_shape"]), dtype=bool)
+    reachable[full.i, full.j] = True
+    nodes = map_nodes(reachable, spacing)
+    if not nodes:
+        raise MapError(f"{full.room_id}: no reachable cell on a {spacing}-cell spacing")
+    keep = np.flatnonzero((full.i % spacing == 0) & (full.j % spacing == 0))
+    meta = {
+        **full.meta,
+        "spacing": int(spacing),
+        "edges": [list(e) for e in translation_edges(reachable, nodes, spacing)],
+        "nodes": len(nodes),
+        "sub_nodes": len(keep),
+    }
+    return TopoMap(
+        meta=meta,
+        i=full.i[keep],
+        j=full.j[keep],
+        heading=full.heading[keep],
+        obs_ids=[full.obs_ids[k] for k in keep],
+        embeddings=full.embeddings[keep],
+        images=[full.images[k] for k in keep],
     )
 
 

@@ -9,6 +9,7 @@ same heading; the label is the larger displacement). Rendering pairs is in
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
@@ -39,6 +40,7 @@ __all__ = [
 ]
 
 KIND = "navigator"  # checkpoints say what they hold: a localizer run is refused here
+FUSIONS = ("early", "late")  # NavigatorConfig.fusion
 
 
 def resize(rgb: np.ndarray, size: int) -> np.ndarray:
@@ -61,6 +63,11 @@ class NavigatorConfig:
     """Everything a navigator run depends on; stored in its checkpoints."""
 
     encoder: str = "resnet18"  # torchvision encoder shared by both views (the paper: VGG-16)
+    # "early": the two views stacked as six input channels, so the first convolution already
+    # compares them pixel by pixel (what a relative-pose answer needs); "late": a siamese
+    # encoder whose pooled features are concatenated (it must say where things are in a
+    # vector that pooling has made blind to position)
+    fusion: str = "early"
     image_size: int = 96  # square input (64..112 keeps a CPU run short)
     hidden: int = 256  # MLP width after the concatenated features
     epochs: int = 10
@@ -82,6 +89,10 @@ class NavigatorConfig:
         if self.encoder not in ENCODER_NAMES:
             raise ModelError(
                 f"navigator.encoder {self.encoder!r}: expected one of {', '.join(ENCODER_NAMES)}"
+            )
+        if self.fusion not in FUSIONS:
+            raise ModelError(
+                f"navigator.fusion {self.fusion!r}: expected one of {', '.join(FUSIONS)}"
             )
         for name in ("image_size", "hidden", "epochs", "batch_size", "train_pairs"):
             if getattr(self, name) < 1:
@@ -128,13 +139,22 @@ class VisualNavigator(nn.Module):
     """
 
     def __init__(
-        self, encoder: str = "resnet18", *, hidden: int = 256, pretrained: Path | None = None
+        self,
+        encoder: str = "resnet18",
+        *,
+        hidden: int = 256,
+        pretrained: Path | None = None,
+        fusion: str = "early",
     ) -> None:
         super().__init__()
-        self.encoder_name = encoder
+        if fusion not in FUSIONS:
+            raise ModelError(f"navigator fusion {fusion!r}: expected one of {', '.join(FUSIONS)}")
+        self.encoder_name, self.fusion = encoder, fusion
         self.encoder, width = image_encoder(encoder, pretrained=pretrained)
+        if fusion == "early":
+            _stack_inputs(self.encoder)
         self.head = nn.Sequential(
-            nn.Linear(2 * width, hidden),
+            nn.Linear(width if fusion == "early" else 2 * width, hidden),
             nn.ReLU(inplace=True),
             nn.Linear(hidden, len(NAVIGATOR_ACTIONS)),
         )
@@ -144,12 +164,35 @@ class VisualNavigator(nn.Module):
             raise ModelError(
                 f"navigator views differ: {tuple(current.shape)} vs {tuple(goal.shape)}"
             )
+        if self.fusion == "early":
+            return self.head(self.encoder(torch.cat([current, goal], dim=1)))
         features = self.encoder(torch.cat([current, goal]))  # one pass, shared weights
         a, b = features.chunk(2)
         return self.head(torch.cat([a, b], dim=1))
 
     def extra_repr(self) -> str:
-        return f"encoder={self.encoder_name!r}"
+        return f"encoder={self.encoder_name!r}, fusion={self.fusion!r}"
+
+
+def _stack_inputs(encoder: nn.Module) -> None:
+    """Widen ``encoder``'s first 3-channel convolution to take two stacked RGB views.
+
+    Each view's half starts as half the old kernel, so an ImageNet-initialised encoder sees
+    the mean of the two views at first and loses nothing of what its weights learned.
+
+    Raises:
+        ModelError: the encoder has no 3-channel convolution.
+    """
+    for parent in encoder.modules():
+        for name, child in parent.named_children():
+            if isinstance(child, nn.Conv2d) and child.in_channels == 3:
+                wide = copy.deepcopy(child)  # keeps its class (e.g. Lite0's "same" padding)
+                wide.in_channels = 6
+                with torch.no_grad():
+                    wide.weight = nn.Parameter(torch.cat([child.weight, child.weight], 1) / 2)
+                setattr(parent, name, wide)
+                return
+    raise ModelError("navigator: the encoder has no 3-channel input convolution to widen")
 
 
 def label_for(forward: int, side: int) -> int:
@@ -221,8 +264,9 @@ def load_navigator(run: Path) -> Policy:
         raise CheckpointError(
             f"{path}: not a navigator checkpoint (train one with train-navigator)"
         )
-    config = NavigatorConfig(**state["config"])
+    # navigators trained before `fusion` existed were siamese
+    config = NavigatorConfig(**{"fusion": "late", **state["config"]})
     device = device_for_run()
-    model = VisualNavigator(config.encoder, hidden=config.hidden).to(device)
+    model = VisualNavigator(config.encoder, hidden=config.hidden, fusion=config.fusion).to(device)
     model.load_state_dict(state["model"])
     return Policy(model, config, device)

@@ -40,7 +40,7 @@ from sgdata.seeds import (
     rng_for,
 )
 
-__all__ = ["jitter", "pair_accuracy", "train_navigator"]
+__all__ = ["fit_navigator", "jitter", "pair_accuracy", "train_navigator"]
 
 
 def train_navigator(
@@ -81,9 +81,30 @@ def train_navigator(
             if config.val_pairs
             else None
         )
+    return fit_navigator(
+        config, train_set, val_set, out, identity=identity, pretrained=pretrained, progress=progress
+    )
+
+
+def fit_navigator(
+    config: NavigatorConfig,
+    train_set: PairSet,
+    val_set: PairSet | None,
+    out: Path,
+    *,
+    identity: dict[str, Any],
+    pretrained: Path | None = None,
+    progress: Progress | None = None,
+) -> list[dict[str, Any]]:
+    """Train on rendered pairs (the second half of :func:`train_navigator`; a comparison of
+    navigator variants fits each on the same pairs). Writes and returns as it does."""
+    if (out / LAST).exists():
+        raise CheckpointError(f"{out}: holds a navigator run already; pick another --out")
     device = device_for_run()
     torch.manual_seed(navigator_init_seed(config.seed))
-    model = VisualNavigator(config.encoder, hidden=config.hidden, pretrained=pretrained).to(device)
+    model = VisualNavigator(
+        config.encoder, hidden=config.hidden, pretrained=pretrained, fusion=config.fusion
+    ).to(device)
     optimizer = torch.optim.SGD(model.parameters(), lr=config.lr, momentum=config.momentum)
     out.mkdir(parents=True, exist_ok=True)
     history: list[dict[str, Any]] = []

@@ -17,6 +17,7 @@ from seannet.navigation.maps import (
     TopoMap,
     build_maps,
     check_map,
+    derive_map,
     load_map,
     map_dirs,
     map_nodes,
@@ -180,3 +181,22 @@ def test_a_map_built_by_another_run_is_refused(
     check_map(load_map(room_dir), localizer, room_dir)
     with pytest.raises(MapError, match="checkpoint_sha256"):
         check_map(load_map(copy), localizer, copy)
+
+
+def test_a_map_derived_from_the_full_map_is_the_map_built_at_its_spacing() -> None:
+    reachable = np.ones((6, 7), dtype=bool)
+    reachable[1, 0] = False  # cuts the run from (0, 0) to (2, 0): no edge there at spacing 2
+    reachable[4, 4] = False  # a node cell of spacing 2 that is not reachable
+    full = _fake_map(reachable, 1)
+    full.meta["grid_shape"] = list(reachable.shape)
+    derived = derive_map(full, 2)
+    built = _fake_map(reachable, 2)
+    assert derived.sub_nodes() == built.sub_nodes() and derived.obs_ids == built.obs_ids
+    assert derived.meta["edges"] == built.meta["edges"] and derived.spacing == 2
+    assert [0, 0, 2, 0] not in derived.meta["edges"] and [0, 0, 0, 2] in derived.meta["edges"]
+    # each kept sub-node keeps its own row of the full map (view and embedding)
+    for key in derived.sub_nodes():
+        np.testing.assert_array_equal(derived.embedding(key), full.embedding(key))
+    assert derived.meta["sub_nodes"] == 4 * len(map_nodes(reachable, 2))
+    with pytest.raises(MapError, match="derive from a spacing-1 map"):
+        derive_map(derived, 4)

@@ -98,3 +98,41 @@ def test_what_the_test_changes_can_be_trained_for(mini_dataset: Path) -> None:
     net = VisualNavigator("efficientnet_lite0", hidden=16, pretrained=Path("imagenet-lite0"))
     inputs = navigator_inputs(pairs.current[:2], "efficientnet_lite0")
     assert inputs.min() >= -1.0 and net(inputs, inputs).shape == (2, 3)
+
+
+def test_early_fusion_sees_both_views_in_its_first_convolution(tmp_path: Path) -> None:
+    import torch
+
+    torch.manual_seed(0)
+    late = VisualNavigator("resnet18", hidden=16, fusion="late")
+    early = VisualNavigator("resnet18", hidden=16, fusion="early")
+    assert early.encoder.conv1.in_channels == 6 and late.encoder.conv1.in_channels == 3
+    x = torch.randn(2, 3, 64, 64)
+    y = torch.randn(2, 3, 64, 64)
+    assert early(x, y).shape == late(x, y).shape == (2, 3)
+    # ImageNet weights are split between the two views: the same view twice looks as before
+    lite = VisualNavigator(
+        "efficientnet_lite0", hidden=16, pretrained=Path("imagenet-lite0"), fusion="late"
+    )
+    lite_early = VisualNavigator(
+        "efficientnet_lite0", hidden=16, pretrained=Path("imagenet-lite0"), fusion="early"
+    )
+    lite.eval(), lite_early.eval()
+    with torch.no_grad():
+        features = lite.encoder(x)
+        torch.testing.assert_close(lite_early.encoder(torch.cat([x, x], 1)), features)
+    with pytest.raises(Exception, match="fusion 'middle'"):
+        NavigatorConfig(fusion="middle")
+
+
+def test_a_navigator_saved_before_fusion_existed_loads_as_siamese(
+    mini_dataset: Path, tmp_path: Path
+) -> None:
+    import torch
+
+    train_navigator(CONFIG.replace(epochs=1, fusion="late"), mini_dataset, tmp_path / "nav")
+    state = load_checkpoint(tmp_path / "nav" / "best.pt")
+    del state["config"]["fusion"]
+    torch.save(state, tmp_path / "nav" / "best.pt")
+    policy = load_navigator(tmp_path / "nav")
+    assert policy.config.fusion == "late" and policy.model.fusion == "late"
