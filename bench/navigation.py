@@ -122,6 +122,7 @@ def run(args: argparse.Namespace) -> None:
         replan=True,
         workers=args.workers,
         out=out / "navigate",
+        strips=out / "strips",
         progress=lambda text: print(text, flush=True),
     )
 

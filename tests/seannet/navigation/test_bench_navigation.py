@@ -61,3 +61,28 @@ def test_tables_from_tiny_runs(
     doc.write_text("# no blocks\n")
     with pytest.raises(SystemExit, match="no block"):
         bench.write_tables(None, doc)
+
+
+def test_navigator_variants_are_compared_on_the_same_pairs(
+    mini_dataset: Path, tmp_path: Path
+) -> None:
+    bench = _bench()
+    out = tmp_path / "bench"
+    args = SimpleNamespace(
+        data=mini_dataset, out=out, pairs=16, val_pairs=8, image_size=64, cross_layout=0.5,
+        epochs=1, encoder="resnet18", jitter=0.0, fusion="early", subset=8, variant_epochs=1,
+    )  # fmt: skip
+    bench.variants(args)
+    record = json.loads((out / bench.VARIANTS).read_text())
+    rows = record["variants"]
+    assert [r["variant"] for r in rows] == list(bench.NAVIGATOR_VARIANTS)
+    assert record["train_pairs"] == 8 and record["epochs"] == 1
+    assert all(r["config"]["train_pairs"] == 8 for r in rows)
+    assert {r["config"]["fusion"] for r in rows} == {"early", "late"}
+    assert all(0 <= r["val_accuracy"] <= 1 and r["seconds_per_epoch"] > 0 for r in rows)
+    # a second call reuses the trained variants (and the cached pairs)
+    stamp = (out / "variants").stat().st_mtime_ns
+    bench.variants(args)
+    assert (out / "variants").stat().st_mtime_ns == stamp
+    block = bench.variants_block(out)
+    assert "| lite0 ImageNet, early fusion |" in block and "8 train pairs" in block
