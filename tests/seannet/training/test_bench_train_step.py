@@ -1,0 +1,57 @@
+"""bench/train_step.py --profile: SeanNet's real step on the mini dataset, part by part."""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+from types import ModuleType
+
+ROOT = Path(__file__).resolve().parents[3]
+
+
+def _bench() -> ModuleType:
+    spec = importlib.util.spec_from_file_location("bench_train_step", ROOT / "bench/train_step.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _number(cell: str) -> float:
+    return float(re.sub(r"[*,% ]", "", cell))
+
+
+def test_profile_books_the_whole_step_to_parts(mini_dataset: Path) -> None:
+    command = [sys.executable, str(ROOT / "bench/train_step.py"), str(mini_dataset), "--profile"]
+    env = {**os.environ, "OMP_NUM_THREADS": "1"}  # one step of 2 triplets, quick on busy cores
+    out = subprocess.run(
+        [*command, "--batch-size", "2", "--steps", "1"],
+        capture_output=True,
+        text=True,
+        env=env,
+        check=True,
+    ).stdout
+    assert "resnet18" not in out  # the profile alone: the comparison did not run
+    rows = [line.split(" | ") for line in out.splitlines() if line.startswith("| ")]
+    header, *parts, step = rows
+    assert header[0] == "| part" and step[0] == "| **step**"
+    labels = [label for _, label in _bench().PARTS]
+    assert len(parts) == len(labels)
+    for row, label in zip(parts, labels, strict=True):
+        assert row[0].startswith("| " + label.split("{")[0].split(" (")[0]), (row[0], label)
+    cells = {row[0][2:]: [_number(c.strip(" |")) for c in row[1:]] for row in parts}
+    assert all(value >= 0 for values in cells.values() for value in values)
+    # forward + backward = total, the shares add up to the step, parts' parameters to the model's
+    assert all(abs(f + b - t) < 0.2 for f, b, t, *_ in list(cells.values())[:-1])
+    assert abs(sum(values[3] for values in cells.values()) - 100) < 1.0
+    assert sum(values[4] for values in cells.values()) == _number(step[-1].strip(" |"))
+    by_key = dict(zip((key for key, _ in _bench().PARTS), cells.values(), strict=True))
+    for key in ("backbone", "head", "objects", "pathways", "fc", "optimiser"):
+        assert by_key[key][2] > 0, key
+    assert by_key["fc"][4] == 6144 * 4096 + 4096 + 4096 * 2048 + 2048  # the issue's 6,144 -> ...
+    assert "GCN fc 6,144 -> 4,096 -> 2,048" in out
+    assert re.search(r"backward booked to a part: (9\d|100)\.\d %", out)
