@@ -62,7 +62,7 @@ _NO_BOXES = np.zeros((0, 4), dtype=np.float32)
 class NavigatorConfig:
     """Everything a navigator run depends on; stored in its checkpoints."""
 
-    encoder: str = "resnet18"  # torchvision encoder shared by both views (the paper: VGG-16)
+    encoder: str = "resnet18"  # torchvision image encoder (the paper: VGG-16)
     # "early": the two views stacked as six input channels, so the first convolution already
     # compares them pixel by pixel (what a relative-pose answer needs); "late": a siamese
     # encoder whose pooled features are concatenated (it must say where things are in a
