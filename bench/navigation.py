@@ -64,6 +64,7 @@ from sgdata.fileio import atomic_write_text  # noqa: E402
 SPLIT = "test"
 PROVENANCE = "provenance.json"
 MAP_SPACING = 2  # the maps `navigate` builds (its default, the authors' spacing)
+NO_FULL_MAPS = "-"  # --full-maps of a localizer whose maps are to be built
 VARIANTS = "variants.json"
 # navigator variants compared on val (name: config changes, ImageNet init)
 NAVIGATOR_VARIANTS = {
@@ -133,6 +134,8 @@ def seed_maps(localizers: list[Path], full_maps: list[Path], data: Path, maps: P
     recall's, bench/results.py): the same views and embeddings, not rendered again. A derived
     map of another checkpoint is found stale by ``navigate`` and built anew."""
     for label, source in zip(run_labels(localizers), full_maps, strict=True):
+        if str(source) == NO_FULL_MAPS:
+            continue
         for room_id in Dataset.open(data).rooms(SPLIT):
             target = maps / label / room_id
             if not (target / MAP_META).is_file() and (source / room_id / MAP_META).is_file():
@@ -334,7 +337,8 @@ def main(argv: list[str] | None = None) -> None:
         "--full-maps",
         type=Path,
         action="append",
-        help="a spacing-1 map directory per --localizer (same order) to derive the maps from",
+        help="a spacing-1 map directory per --localizer (same order) to derive the maps from; "
+        f"{NO_FULL_MAPS!r}: build that localizer's maps",
     )
     choose.add_argument("--subset", type=int, default=4800, help="train pairs per variant")
     choose.add_argument("--variant-epochs", type=int, default=3)
