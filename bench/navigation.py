@@ -43,6 +43,8 @@ from results import provenance  # noqa: E402  (bench/results.py: one home for pr
 import seannet  # noqa: E402,F401  (imports torch's compiler stack first: see tests/conftest.py)
 from seannet.data.datasets import dataset_identity  # noqa: E402
 from seannet.data.live_views import LiveRooms  # noqa: E402
+from seannet.navigation.episodes import CASES  # noqa: E402
+from seannet.navigation.localizer import run_epsilon  # noqa: E402
 from seannet.navigation.maps import MAP_META, derive_map, load_map, save_map  # noqa: E402
 from seannet.navigation.navigate import run_labels, run_navigation  # noqa: E402
 from seannet.navigation.navigator import NavigatorConfig  # noqa: E402
@@ -66,6 +68,11 @@ PROVENANCE = "provenance.json"
 MAP_SPACING = 2  # the maps `navigate` builds (its default, the authors' spacing)
 NO_FULL_MAPS = "-"  # --full-maps of a localizer whose maps are to be built
 VARIANTS = "variants.json"
+EPSILON = "epsilon.json"
+# the stop thresholds tried on val rooms per localizer, offsets from its eval epsilon (chosen
+# for telling same-pose pairs apart, not for stopping on a sub-goal in another layout)
+EPSILON_OFFSETS = (0.0, -0.05, -0.10, -0.15, -0.20)
+VAL_EPSILON = "navigation on val"  # the source the tables print beside such an epsilon
 # navigator variants compared on val (name: config changes, ImageNet init)
 NAVIGATOR_VARIANTS = {
     "resnet18, late fusion (siamese)": ({"fusion": "late"}, None),
@@ -104,7 +111,9 @@ def navigator_config(args: argparse.Namespace) -> NavigatorConfig:
 def run(args: argparse.Namespace) -> None:
     out: Path = args.out
     out.mkdir(parents=True, exist_ok=True)
-    atomic_write_text(out / PROVENANCE, json.dumps(provenance(args.data, sys.argv), indent=2))
+    suffix = "-val-epsilon" if args.val_epsilon else ""
+    record = json.dumps(provenance(args.data, sys.argv), indent=2)
+    atomic_write_text(out / PROVENANCE.replace(".json", f"{suffix}.json"), record)
     config = navigator_config(args)
     if args.full_maps:
         if len(args.full_maps) != len(args.localizer):
@@ -114,18 +123,71 @@ def run(args: argparse.Namespace) -> None:
     if not (navigator / BEST).is_file():
         cache = out / "navigator_pairs"
         train_navigator(config, args.data, navigator, cache=cache, pretrained=args.pretrained)
+    epsilon = None
+    if args.val_epsilon:
+        chosen = json.loads((out / EPSILON).read_text())["localizers"]
+        epsilon = {Path(c["run"]): (c["chosen"], VAL_EPSILON) for c in chosen}
     run_navigation(
         args.localizer,
         navigator,
         args.data,
         split=SPLIT,
         episodes=args.episodes,
+        epsilon=epsilon,
         replan=True,
         workers=args.workers,
-        out=out / "navigate",
-        strips=out / "strips",
+        out=out / f"navigate{suffix}",
+        maps=out / "navigate" / "maps",  # maps do not depend on epsilon
+        strips=out / f"strips{suffix}",
         progress=lambda text: print(text, flush=True),
     )
+
+
+def choose_epsilon(args: argparse.Namespace) -> None:
+    """Per localizer, the stop threshold of :data:`EPSILON_OFFSETS` with the best mean success
+    (N and A, the paper's rule) on the val rooms; ``OUT/epsilon.json``."""
+    out: Path = args.out
+    rows = []
+    for run, label in zip(args.localizer, run_labels(args.localizer), strict=True):
+        found = run_epsilon(run)
+        if found is None:
+            raise SystemExit(f"{run}: no evaluated epsilon; run `seannet eval` on val first")
+        base, source = found
+        grid = []
+        for offset in EPSILON_OFFSETS:
+            epsilon = round(base + offset, 4)
+            results = run_navigation(
+                [run],
+                out / "navigator",
+                args.data,
+                split="val",
+                episodes=args.val_episodes,
+                epsilon=epsilon,
+                workers=args.workers,
+                out=out / "epsilon" / label / f"{epsilon:.4f}",
+                maps=out / "epsilon" / "maps" / label,
+            )
+            episodes = results["runs"][0]["episodes"]
+            success = {
+                case: float(
+                    np.mean(
+                        [e["paper"]["outcome"] == "success" for e in episodes if e["case"] == case]
+                    )
+                )
+                for case in CASES
+            }
+            grid.append({"epsilon": epsilon, "offset": offset, "success": success})
+            print(f"{label} epsilon {epsilon:.3f}: success {success}", flush=True)
+        best = max(grid, key=lambda g: sum(g["success"].values()))  # the first of equals
+        rows.append({"run": str(run), "label": label, "eval_epsilon": base,
+                     "eval_source": source, "grid": grid, "chosen": best["epsilon"]})  # fmt: skip
+    record = {
+        "provenance": provenance(args.data, sys.argv),
+        "split": "val",
+        "episodes_per_case_and_room": args.val_episodes,
+        "localizers": rows,
+    }
+    atomic_write_text(out / EPSILON, json.dumps(record, indent=2))
 
 
 def seed_maps(localizers: list[Path], full_maps: list[Path], data: Path, maps: Path) -> None:
@@ -323,6 +385,12 @@ def main(argv: list[str] | None = None) -> None:
     sub = parser.add_subparsers(dest="verb", required=True)
     go = sub.add_parser("run", help="make the runs")
     choose = sub.add_parser("variants", help="compare navigator variants on val")
+    stop = sub.add_parser("epsilon", help="choose each localizer's stop threshold on val rooms")
+    stop.add_argument("data", type=Path)
+    stop.add_argument("out", type=Path)
+    stop.add_argument("--localizer", type=Path, action="append", required=True)
+    stop.add_argument("--val-episodes", type=int, default=10)
+    stop.add_argument("--workers", type=int, default=2)
     for verb in (go, choose):
         _pair_options(verb)
     go.add_argument("--localizer", type=Path, action="append", required=True)
@@ -333,6 +401,11 @@ def main(argv: list[str] | None = None) -> None:
     go.add_argument("--fusion", choices=("early", "late"), default="early")
     go.add_argument("--episodes", type=int, default=20)
     go.add_argument("--workers", type=int, default=2)
+    go.add_argument(
+        "--val-epsilon",
+        action="store_true",
+        help=f"stop thresholds of OUT/{EPSILON} (the epsilon verb) into OUT/navigate-val-epsilon",
+    )
     go.add_argument(
         "--full-maps",
         type=Path,
@@ -351,6 +424,8 @@ def main(argv: list[str] | None = None) -> None:
         run(args)
     elif args.verb == "variants":
         variants(args)
+    elif args.verb == "epsilon":
+        choose_epsilon(args)
     else:
         write_tables(args.out, args.output)
 

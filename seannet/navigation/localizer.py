@@ -84,7 +84,12 @@ def run_epsilon(run: Path) -> tuple[float, str] | None:
 
 
 def load_localizer(
-    run: Path, data: Path, *, epsilon: float | None = None, require_epsilon: bool = True
+    run: Path,
+    data: Path,
+    *,
+    epsilon: float | None = None,
+    source: str = "--epsilon",
+    require_epsilon: bool = True,
 ) -> Localizer:
     """``run/best.pt`` on ``data`` (the dataset it was trained on) as a localizer.
 
@@ -92,6 +97,7 @@ def load_localizer(
         run: the run directory.
         data: the dataset the run was trained on.
         epsilon: the threshold to use; None reads the run's eval files (:func:`run_epsilon`).
+        source: where a given ``epsilon`` comes from (reported beside it).
         require_epsilon: without one, raise (True) or leave epsilon NaN (building maps).
 
     Raises:
@@ -109,8 +115,6 @@ def load_localizer(
                 f"--data {data} --split test` first, or pass --epsilon"
             )
         epsilon, source = found
-    else:
-        source = "--epsilon"
     if require_epsilon and not math.isfinite(epsilon):
         raise NavigationError(f"epsilon {epsilon}: expected a finite number")
     return Localizer(

@@ -62,7 +62,7 @@ def run_navigation(
     seed: int = 0,
     k_max: int = K_MAX,
     spacing: int = 2,
-    epsilon: float | None = None,
+    epsilon: float | dict[Path, tuple[float, str]] | None = None,
     replan: bool = False,
     workers: int = 1,
     out: Path | None = None,
@@ -77,6 +77,8 @@ def run_navigation(
         replan: run every episode under bump and replan; its paper-rule outcome is read off
             the same run (see :mod:`seannet.navigation.episodes`).
         workers: processes running maps and episodes in parallel.
+        epsilon: one threshold for every run, or per run ``(epsilon, where it comes from)``
+            (a run left out reads its eval files); None: each run's eval files.
 
     Writes ``navigate_<split>.json`` and ``.md`` into ``out`` (default: the navigator run),
     maps under ``maps`` (default: ``out/maps``), and under ``strips`` when given, per run,
@@ -105,7 +107,7 @@ def run_navigation(
     if not rooms:
         raise NavigationError(f"{data}: split {split!r} has no room to navigate in")
     say = progress or (lambda _: None)
-    localizers = [load_localizer(run, data, epsilon=epsilon) for run in runs]
+    localizers = [_localizer(run, data, epsilon) for run in runs]
     settings = {
         "split": split,
         "episodes_per_case_and_room": episodes,
@@ -171,6 +173,15 @@ def run_navigation(
     atomic_write_text(out / f"navigate_{split}.md", markdown(results))
     results["written"] = str(out / f"navigate_{split}.md")
     return results
+
+
+def _localizer(
+    run: Path, data: Path, epsilon: float | dict[Path, tuple[float, str]] | None
+) -> Localizer:
+    if isinstance(epsilon, dict):
+        given, source = epsilon.get(run, (None, ""))
+        return load_localizer(run, data, epsilon=given, source=source)
+    return load_localizer(run, data, epsilon=epsilon)
 
 
 def run_labels(runs: list[Path]) -> list[str]:
