@@ -73,6 +73,7 @@ EPSILON = "epsilon.json"
 # for telling same-pose pairs apart, not for stopping on a sub-goal in another layout)
 EPSILON_OFFSETS = (0.0, -0.05, -0.10, -0.15, -0.20)
 VAL_EPSILON = "navigation on val"  # the source the tables print beside such an epsilon
+VAL_SUFFIX = "-val-epsilon"  # navigate, strips and provenance of the run with those
 # navigator variants compared on val (name: config changes, ImageNet init)
 NAVIGATOR_VARIANTS = {
     "resnet18, late fusion (siamese)": ({"fusion": "late"}, None),
@@ -111,7 +112,7 @@ def navigator_config(args: argparse.Namespace) -> NavigatorConfig:
 def run(args: argparse.Namespace) -> None:
     out: Path = args.out
     out.mkdir(parents=True, exist_ok=True)
-    suffix = "-val-epsilon" if args.val_epsilon else ""
+    suffix = VAL_SUFFIX if args.val_epsilon else ""
     record = json.dumps(provenance(args.data, sys.argv), indent=2)
     atomic_write_text(out / PROVENANCE.replace(".json", f"{suffix}.json"), record)
     config = navigator_config(args)
@@ -295,10 +296,10 @@ def paper_rows() -> list[list[str]]:
     ]
 
 
-def measured_block(out: Path) -> str:
-    """The tables of ``out``'s runs, stamped with what made them."""
-    made = json.loads((out / PROVENANCE).read_text())
-    results = read_results(out / "navigate" / f"navigate_{SPLIT}.json")
+def measured_block(out: Path, suffix: str = "") -> str:
+    """The tables of ``out``'s runs (``navigate{suffix}``), stamped with what made them."""
+    made = json.loads((out / PROVENANCE.replace(".json", f"{suffix}.json")).read_text())
+    results = read_results(out / f"navigate{suffix}" / f"navigate_{SPLIT}.json")
     history = json.loads((out / "navigator" / HISTORY).read_text())
     state = load_checkpoint(out / "navigator" / BEST)
     config = state["config"]
@@ -343,6 +344,39 @@ def measured_block(out: Path) -> str:
             *_table(SPLIT_HEADER, rate_rows(results, "replan", split=True)),
         ]
     lines += ["", "Time per episode:", "", *_table(TIME_HEADER, time_rows(results))]
+    eps = [
+        [f"{r['model']} ({r['label']})", f"{r['epsilon']:.3f}", r["epsilon_source"]]
+        for r in results["runs"]
+    ]
+    lines += ["", *_table(["localizer", "epsilon", "from"], eps)]
+    return "\n".join(lines)
+
+
+def epsilon_block(out: Path) -> str:
+    """The stop thresholds tried on val rooms (``OUT/epsilon.json``), then the test with the
+    chosen ones."""
+    record = json.loads((out / EPSILON).read_text())
+    made = record["provenance"]
+    header = ["localizer", *(f"{o:+.2f}" for o in EPSILON_OFFSETS), "chosen"]
+    rows = []
+    for loc in record["localizers"]:
+        cells = [
+            f"{g['epsilon']:.3f}: {100 * g['success']['N']:.0f} / {100 * g['success']['A']:.0f}"
+            for g in loc["grid"]
+        ]
+        rows.append([loc["label"], *cells, f"{loc['chosen']:.3f}"])
+    lines = [
+        f"Made {made['started']} by commit `{made['commit'][:12]}` on `{made['data']}` "
+        f"(manifest sha256 `{made['manifest_sha256'][:16]}`): `{made['command']}`. "
+        f"{record['episodes_per_case_and_room']} episodes per case and room on the "
+        f"{record['split']} rooms, paper rule; each cell: epsilon: success % N / A. Columns: "
+        "offsets from the localizer's eval epsilon; chosen: the best mean of N and A.",
+        "",
+        *_table(header, rows),
+    ]
+    if (out / f"navigate{VAL_SUFFIX}" / f"navigate_{SPLIT}.json").is_file():
+        lines += ["", "The test rooms with the chosen thresholds:", ""]
+        lines.append(measured_block(out, VAL_SUFFIX))
     return "\n".join(lines)
 
 
@@ -367,6 +401,8 @@ def write_tables(out: Path | None, doc: Path) -> None:
         text = replace_block(text, "measured", measured_block(out))
         if (out / VARIANTS).is_file():
             text = replace_block(text, "variants", variants_block(out))
+        if (out / EPSILON).is_file():
+            text = replace_block(text, "epsilon", epsilon_block(out))
     atomic_write_text(doc, text)
 
 

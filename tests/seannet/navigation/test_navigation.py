@@ -207,3 +207,20 @@ def test_navigate_wants_a_navigator_or_the_oracle(localizer_run: Path, mini_data
     assert result.returncode != 0 and "Traceback" not in result.stderr
     (line,) = result.stderr.strip().splitlines()
     assert "--navigator RUN" in line and "--oracle" in line
+
+
+def test_a_stop_threshold_per_localizer_and_where_it_comes_from(
+    navigation_run: SimpleNamespace, localizer_run: Path, mini_dataset: Path, tmp_path: Path
+) -> None:
+    given = {localizer_run: (0.25, "navigation on val")}
+    results = run_navigation(
+        [localizer_run], navigation_run.navigator, mini_dataset, episodes=1, epsilon=given,
+        out=tmp_path, maps=navigation_run.out / "maps",
+    )  # fmt: skip
+    (run,) = results["runs"]
+    assert (run["epsilon"], run["epsilon_source"]) == (0.25, "navigation on val")
+    assert "| 0.250 | navigation on val |" in (tmp_path / "navigate_test.md").read_text()
+    # a run left out reads its eval files: this one has none, so it is refused
+    with pytest.raises(NavigationError, match="no eval_<split>.json"):
+        run_navigation([localizer_run], navigation_run.navigator, mini_dataset, epsilon={},
+                       out=tmp_path / "none")  # fmt: skip
