@@ -193,7 +193,7 @@ def timed_parts(model: SeanNet, loss_fn: torch.nn.Module, clock: PartClock) -> I
         *((m, clock.head_part) for m in (model.head, *model.head)),  # head[1:] calls children
         (model.objects, lambda: "objects"),
         *((p, lambda: "pathways") for p in model.gcn.pathways),
-        (model.gcn.fc, lambda: "fc"),
+        *((m, lambda: "fc") for m in model.gcn.fc),  # forward_nodes calls them one by one
         *((m, lambda: "fusion") for m in (model.image_norm, model.graph_norm, model.fusion)),
         (loss_fn, lambda: "loss"),
     ]

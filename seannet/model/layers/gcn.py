@@ -10,8 +10,14 @@ import torch
 from torch import Tensor, nn
 
 from seannet.errors import ModelError
+from seannet.model.layers.column_linear import ColumnLinear
 
 __all__ = ["GCNLayer", "GCNPathway", "MultiPathwayGCN", "NodeEdges"]
+
+# Used (relation, slot) units with at most this many empty ones between them share one run of
+# the fc's input, the empty ones multiplied as zeros: one more matrix product per run costs
+# about what a few slots' 8 columns do (bench/gcn_fc.py, 2 and 16 views).
+RUN_GAP = 3
 
 
 class NodeEdges(NamedTuple):
@@ -181,7 +187,7 @@ class MultiPathwayGCN(nn.Module):
         )
         flat = num_relations * num_slots * self.pathways[0].dims[-1]
         self.fc = nn.Sequential(
-            nn.Linear(flat, hidden_dim),
+            ColumnLinear(flat, hidden_dim),  # forward_nodes gives it the used slots' columns
             nn.ReLU(inplace=True),
             nn.Linear(hidden_dim, out_dim),
             nn.ReLU(inplace=True),
@@ -213,8 +219,10 @@ class MultiPathwayGCN(nn.Module):
 
         A view fills ~10-30 of its M slots: the dense form multiplies and drops out
         B x M rows that stay zero (two thirds of a CPU SeanNet step at M = 256); here the
-        pathways run on the K present nodes and the adjacency's edges between them, and
-        only their 8-wide outputs are scattered to (view, slot) for the fc.
+        pathways run on the K present nodes and the adjacency's edges between them. On a CPU
+        the fc's first layer then reads only the columns of the slots some view fills (runs of
+        slots, :class:`ColumnLinear`), not the (B, R·M·8) vector that is ~97 % zeros; on
+        another device the outputs fill that whole vector, one product.
 
         Args:
             x: (K, dims[0]) features of the present nodes.
@@ -233,12 +241,59 @@ class MultiPathwayGCN(nn.Module):
                 f"(K, F) and (B, {self.num_relations}, {m}, {m})"
             )
         edges = self._node_edges(box_view, slots, adjacency, num_views)
-        flat = []
-        for p, rel_edges in zip(self.pathways, edges, strict=True):
-            out = p(x, rel_edges)
-            grid = out.new_zeros(num_views, m, out.shape[1])
-            flat.append(grid.index_put((box_view, slots), out).flatten(1))
-        return self.fc(torch.cat(flat, dim=1))
+        out = torch.cat([p(x, e) for p, e in zip(self.pathways, edges, strict=True)])
+        first, *rest = self.fc
+        h = first(*self.fc_input(out, box_view, slots, num_views=num_views))
+        for layer in rest:
+            h = layer(h)
+        return h
+
+    def fc_input(
+        self, out: Tensor, box_view: Tensor, slots: Tensor, *, num_views: int
+    ) -> tuple[Tensor, list[tuple[int, int]]]:
+        """The fc's input from the pathways' outputs on the present nodes, as the
+        :class:`ColumnLinear` ``(x, runs)`` of :meth:`forward_nodes`.
+
+        Args:
+            out: (R·K, dims[-1]) the pathways' outputs, relation-major: relation r's K rows
+                are ``out[r * K : (r + 1) * K]``.
+            box_view, slots: (K,) long, each node's view and slot.
+            num_views: B.
+
+        Returns:
+            x (B, width) and the runs ``(start, length)`` of the flattened
+            [vec(X_on); vec(X_in); vec(X_prox)] it holds, side by side.
+        """
+        m, c = self.num_slots, out.shape[1]
+        # unit r·M + slot: one (relation, slot) of the flattened vector, c columns wide
+        units = (torch.arange(self.num_relations, device=slots.device) * m).unsqueeze(1)
+        runs, position, width = self._unit_runs((units + slots).flatten())
+        x = out.new_zeros(num_views, width, c)
+        x = x.index_put((box_view.repeat(self.num_relations), position), out)
+        return x.flatten(1), [(start * c, length * c) for start, length in runs]
+
+    def _unit_runs(self, units: Tensor) -> tuple[list[tuple[int, int]], Tensor, int]:
+        """The fc's input as runs of (relation, slot) units: the runs ``(start, length)``,
+        each of ``units``' position in the runs laid side by side, and their total length.
+
+        On a CPU: the used units, runs at most :data:`RUN_GAP` empty units apart merged. On
+        another device: one run of all R·M units, the dense vector (no host sync, one
+        product)."""
+        total = self.num_relations * self.num_slots
+        if units.device.type != "cpu":
+            return [(0, total)], units, total
+        used = torch.zeros(total, dtype=torch.bool)
+        used[units] = True
+        ids = used.nonzero().flatten()  # sorted
+        apart = ids.diff() > RUN_GAP + 1
+        starts = torch.cat((ids[:1], ids[1:][apart]))
+        lengths = torch.cat((ids[:-1][apart], ids[-1:])) + 1 - starts
+        offsets = lengths.cumsum(0) - lengths  # where each run starts, side by side
+        width = int(lengths.sum())
+        span = torch.repeat_interleave(starts - offsets, lengths) + torch.arange(width)
+        position = torch.full((total,), -1, dtype=torch.long)
+        position[span] = torch.arange(width)
+        return list(zip(starts.tolist(), lengths.tolist(), strict=True)), position[units], width
 
     def _node_edges(
         self, box_view: Tensor, slots: Tensor, adjacency: Tensor, num_views: int

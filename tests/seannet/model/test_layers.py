@@ -10,6 +10,7 @@ from torch.nn import functional as F
 from seannet import ModelError
 from seannet.model.layers import (
     BoxEncoding,
+    ColumnLinear,
     GCNLayer,
     GCNPathway,
     MultiPathwayGCN,
@@ -278,3 +279,125 @@ def test_gcn_on_present_nodes_ignores_edges_of_empty_slots_and_checks_shapes() -
     )
     with pytest.raises(ModelError, match="expected"):
         gcn.forward_nodes(x, box_view, slots, a[:, :2], num_views=3)
+
+
+def _views(
+    box_view: list[int], slots: list[int], num_views: int, seed: int
+) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, torch.Tensor]:
+    """The given nodes, random features and a row-normalised (B, 3, 12, 12) adjacency with
+    edges among each view's present nodes only."""
+    g = torch.Generator().manual_seed(seed)
+    view, slot = torch.tensor(box_view, dtype=torch.long), torch.tensor(slots, dtype=torch.long)
+    a = torch.zeros(num_views, 3, 12, 12)
+    for v in range(num_views):
+        s = slot[view == v]
+        mask = torch.rand(3, len(s), len(s), generator=g) < 0.5
+        a[v][:, s.unsqueeze(1), s.unsqueeze(0)] = mask * (torch.rand(mask.shape, generator=g) + 0.1)
+    return view, slot, torch.randn(len(slot), 32, generator=g), _row_normalised(a)
+
+
+FC_CASES = {  # (box_view, slots, B) of M = 12; runs of used slots with gaps above RUN_GAP
+    "empty views": ([1, 1, 1, 3, 3], [0, 5, 6, 5, 11], 4),
+    "a view with every slot": ([0] * 12 + [1], [*range(12), 3], 3),
+    "repeated slots across views": (
+        [0, 0, 0, 1, 1, 1, 1, 2, 2, 2],
+        [2, 7, 8, 0, 2, 7, 8] + [2, 7, 8],
+        3,
+    ),
+    "no node at all": ([], [], 2),
+}
+
+
+@pytest.mark.parametrize("case", FC_CASES)
+@pytest.mark.parametrize("sparse", [False, True])
+def test_gcn_fc_on_used_slots_equals_the_dense_form_with_its_gradients(
+    case: str, sparse: bool
+) -> None:
+    torch.manual_seed(0)
+    gcn = MultiPathwayGCN(num_slots=12, dims=(32, 16, 8, 4), hidden_dim=20, out_dim=10).eval()
+    box_view, slots, x, a = _views(*FC_CASES[case], seed=3)
+    first = gcn.fc[0]
+    grads = []
+    for form in ("dense", "nodes"):
+        gcn.zero_grad(set_to_none=True)
+        nodes = x.clone().requires_grad_(True)
+        if form == "dense":
+            grid = nodes.new_zeros(a.shape[0], 12, 32).index_put((box_view, slots), nodes)
+            out = gcn(grid, a)
+        else:
+            adjacency = a.to_sparse() if sparse else a
+            out = gcn.forward_nodes(nodes, box_view, slots, adjacency, num_views=a.shape[0])
+        (out * torch.linspace(-1, 1, out.numel()).view(out.shape)).sum().backward()
+        grads.append((out.detach(), first.weight.grad, first.bias.grad, nodes.grad))
+    (dense, *dense_grads), (got, *got_grads) = grads
+    torch.testing.assert_close(got, dense, rtol=1e-5, atol=1e-6)
+    for name, g, ref in zip(("W1", "b1", "node features"), got_grads, dense_grads, strict=True):
+        assert g is not None and ref is not None, name
+        torch.testing.assert_close(g, ref, rtol=1e-5, atol=1e-6, msg=lambda m, n=name: f"{n}: {m}")
+    assert dense.abs().sum() > 0
+    assert (first.weight.grad.abs().sum() > 0) == (len(slots) > 0)
+
+
+def test_gcn_fc_is_bit_reproducible() -> None:
+    gcn = MultiPathwayGCN(num_slots=12, dims=(32, 16, 8, 4), hidden_dim=20, out_dim=10).train()
+    box_view, slots, x, a = _views(*FC_CASES["empty views"], seed=4)
+    runs = []
+    for _ in range(2):
+        torch.manual_seed(1)  # dropout
+        gcn.zero_grad(set_to_none=True)
+        out = gcn.forward_nodes(x, box_view, slots, a, num_views=4)
+        out.sum().backward()
+        runs.append((out.detach(), gcn.fc[0].weight.grad))
+    assert all(torch.equal(u, v) for u, v in zip(*runs, strict=True))
+
+
+def test_gcn_state_dict_is_the_nn_linear_one() -> None:
+    """Checkpoints written before the fc read column runs load unchanged."""
+    torch.manual_seed(0)
+    gcn = MultiPathwayGCN(num_slots=12, dims=(32, 16, 8, 4), hidden_dim=20, out_dim=10).eval()
+    old_fc = torch.nn.Sequential(
+        torch.nn.Linear(3 * 12 * 4, 20), torch.nn.ReLU(), torch.nn.Linear(20, 10), torch.nn.ReLU()
+    )
+    assert {k: v.shape for k, v in gcn.fc.state_dict().items()} == {
+        k: v.shape for k, v in old_fc.state_dict().items()
+    }
+    gcn.fc.load_state_dict(old_fc.state_dict())
+    box_view, slots, x, a = _views(*FC_CASES["empty views"], seed=5)
+    grid = torch.zeros(4, 12, 32).index_put((box_view, slots), x)
+    flat = torch.cat([p(grid, a[:, r]).flatten(1) for r, p in enumerate(gcn.pathways)], 1)
+    torch.testing.assert_close(
+        gcn.forward_nodes(x, box_view, slots, a, num_views=4), old_fc(flat), rtol=1e-5, atol=1e-6
+    )
+
+
+@pytest.mark.parametrize("bias", [True, False])
+def test_column_linear_on_runs_is_the_linear_of_the_zero_filled_input(bias: bool) -> None:
+    torch.manual_seed(0)
+    layer = ColumnLinear(10, 6, bias=bias)
+    runs, columns = [(1, 2), (3, 1), (7, 3)], torch.tensor([1, 2, 3, 7, 8, 9])
+    g = torch.randn(4, 6)
+    results = []
+    for form in ("runs", "full"):
+        layer.zero_grad(set_to_none=True)
+        x = torch.randn(4, 6, generator=torch.Generator().manual_seed(1)).requires_grad_(True)
+        if form == "runs":
+            out = layer(x, runs)
+        else:
+            out = layer(torch.zeros(4, 10).index_copy(1, columns, x))
+        (out * g).sum().backward()
+        bias_grad = layer.bias.grad if bias else None
+        results.append((out.detach(), x.grad, layer.weight.grad, bias_grad))
+    for got, ref in zip(*results, strict=True):
+        torch.testing.assert_close(got, ref)
+    assert not results[0][2][:, [0, 4, 5, 6]].any()  # columns outside the runs: zero gradient
+
+
+def test_column_linear_checks_runs() -> None:
+    layer = ColumnLinear(10, 6)
+    empty = layer(torch.zeros(3, 0), [])
+    torch.testing.assert_close(empty, layer.bias.expand(3, 6))
+    for runs in ([(2, 3), (4, 1)], [(8, 3)], [(1, 0)], [(-1, 2)]):
+        with pytest.raises(ModelError, match="runs"):
+            layer(torch.zeros(3, sum(n for _, n in runs)), runs)
+    with pytest.raises(ModelError, match=r"expected \(B, 3\)"):
+        layer(torch.zeros(3, 4), [(0, 3)])

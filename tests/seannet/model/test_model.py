@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import io
+
 import pytest
 import torch
 from torch.nn import functional as F
@@ -137,6 +139,27 @@ def test_training_step_reaches_every_part() -> None:
             if param.ndim >= 2:  # every weight matrix and kernel learns, not just one of them
                 assert param.grad.abs().sum() > 0, f"{name}.{param_name} has no gradient"
     assert not any(n.startswith("objects.word_vectors") for n, _ in net.named_parameters())
+
+
+def test_state_dict_round_trip_keeps_the_gcn_fc_keys(model: SeanNet) -> None:
+    """The GCN fc's first layer reads column runs; its parameters stay nn.Linear's."""
+    state = model.state_dict()
+    flat, hidden = 3 * M * 8, model.gcn.fc[2].in_features
+    assert {k: tuple(v.shape) for k, v in state.items() if k.startswith("gcn.fc.")} == {
+        "gcn.fc.0.weight": (hidden, flat),
+        "gcn.fc.0.bias": (hidden,),
+        "gcn.fc.2.weight": (model.gcn.out_dim, hidden),
+        "gcn.fc.2.bias": (model.gcn.out_dim,),
+    }
+    buffer = io.BytesIO()
+    torch.save(state, buffer)
+    buffer.seek(0)
+    torch.manual_seed(1)
+    again = build_model("seannet", depth=18, num_slots=M, roi_size=7).eval()
+    again.load_state_dict(torch.load(buffer, weights_only=True))
+    batch = _batch((3, 0, 5), seed=4)
+    with torch.no_grad():
+        assert torch.equal(again.embed(batch), model.embed(batch))
 
 
 def test_the_layout_pathway_sees_where_the_boxes_are(model: SeanNet) -> None:
