@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import shutil
 from pathlib import Path
 from types import ModuleType, SimpleNamespace
 
 import pytest
+
+from ...bench_scripts import load_bench
 
 ROOT = Path(__file__).resolve().parents[3]
 DOC = """# Navigation
@@ -25,11 +26,7 @@ prose that stays
 
 
 def _bench() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("bench_navigation", ROOT / "bench/navigation.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_bench("navigation")
 
 
 def test_tables_from_tiny_runs(

@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import os
 import subprocess
 import sys
 from pathlib import Path
 from types import ModuleType
+
+from ...bench_scripts import load_bench
 
 ROOT = Path(__file__).resolve().parents[3]
 # One bathroom with 2 layouts at 64 px: what the pipeline does, in a few seconds.
@@ -26,11 +27,7 @@ height = 64
 
 
 def _bench() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("bench_stages", ROOT / "bench/stages.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_bench("stages")
 
 
 def test_stages_add_up_to_the_wall_time(tmp_path: Path) -> None:
