@@ -1,18 +1,21 @@
 """docs/navigation.md as code: make the navigation runs, then write its tables from them.
 
+    python bench/navigation.py variants DATA OUT [the run's pair options] [--subset 4800]
+        [--variant-epochs 3]
     python bench/navigation.py run DATA OUT --localizer RUN [--localizer RUN ...]
         [--pairs 20000] [--val-pairs 2000] [--image-size 96] [--epochs 10] [--episodes 20]
         [--workers 2] [--encoder resnet18] [--pretrained imagenet-lite0] [--cross-layout 0.5]
-        [--jitter 0.2]
-    python bench/navigation.py variants DATA OUT [the run's pair options] [--subset 4800]
-        [--variant-epochs 3]
+        [--jitter 0.2] [--fusion early] [--full-maps DIR|- ...] [--val-epsilon]
+    python bench/navigation.py epsilon DATA OUT --localizer RUN [...] [--val-episodes 10]
     python bench/navigation.py tables [OUT] [-o docs/navigation.md]
 
 ``run`` records what made the runs (commit, command, dataset manifest sha256 and format
 version) in ``OUT/provenance.json``, trains the navigator into ``OUT/navigator`` (pairs cached
 in ``OUT/navigator_pairs``; skipped once trained) and runs ``seannet navigate`` of every
 localizer on the test rooms under the paper's rule and ``--replan`` into ``OUT/navigate``
-(it resumes where a killed run stopped).
+(it resumes where a killed run stopped). ``--full-maps`` derives each localizer's maps from
+its spacing-1 maps instead of rendering them; ``--val-epsilon`` runs again with the stop
+thresholds that ``epsilon`` chose on the val rooms, into ``OUT/navigate-val-epsilon``.
 
 ``variants`` chooses the navigator on val before ``run``: each variant (fusion, ImageNet init,
 light jitter) is trained on the same subset of ``run``'s cached train pairs (``--subset``
@@ -196,10 +199,11 @@ def seed_maps(localizers: list[Path], full_maps: list[Path], data: Path, maps: P
     ``navigate`` would build, derived from that localizer's spacing-1 map (e.g. the full-map
     recall's, bench/results.py): the same views and embeddings, not rendered again. A derived
     map of another checkpoint is found stale by ``navigate`` and built anew."""
+    rooms = Dataset.open(data).rooms(SPLIT)
     for label, source in zip(run_labels(localizers), full_maps, strict=True):
         if str(source) == NO_FULL_MAPS:
             continue
-        for room_id in Dataset.open(data).rooms(SPLIT):
+        for room_id in rooms:
             target = maps / label / room_id
             if not (target / MAP_META).is_file() and (source / room_id / MAP_META).is_file():
                 save_map(derive_map(load_map(source / room_id), MAP_SPACING), target)
