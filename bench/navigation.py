@@ -23,8 +23,8 @@ pairs spread over every train room) for ``--variant-epochs`` and scored on all i
 ``OUT/variants.json`` holds the table.
 
 ``tables`` rewrites the blocks of docs/navigation.md between ``<!-- bench/navigation.py: NAME
--->`` and ``<!-- end NAME -->``: ``paper`` (the paper's Table II) always, ``measured`` from
-``OUT`` when given. No figure in them is typed by hand.
+-->`` and ``<!-- end NAME -->``: ``paper`` (the paper's Table II) always; ``measured``,
+``variants`` and ``epsilon`` from ``OUT`` when given. No figure in them is typed by hand.
 """
 
 from __future__ import annotations
