@@ -83,3 +83,24 @@ def test_navigator_variants_are_compared_on_the_same_pairs(
     assert (out / "variants").stat().st_mtime_ns == stamp
     block = bench.variants_block(out)
     assert "| lite0 ImageNet, early fusion |" in block and "8 train pairs" in block
+
+
+def test_the_stop_thresholds_tried_on_val_are_tabled(tmp_path: Path) -> None:
+    bench = _bench()
+    grid = [
+        {"epsilon": round(0.7 + o, 4), "offset": o, "success": {"N": 0.5 - o, "A": 0.2}}
+        for o in bench.EPSILON_OFFSETS
+    ]
+    record = {
+        "provenance": {"started": "now", "commit": "c0ffee" * 7, "data": "d",
+                       "manifest_sha256": "ab" * 32, "command": "bench/navigation.py epsilon"},
+        "split": "val",
+        "episodes_per_case_and_room": 10,
+        "localizers": [{"run": "r", "label": "seed0", "eval_epsilon": 0.7,
+                        "eval_source": "eval_val.json", "grid": grid, "chosen": 0.5}],
+    }  # fmt: skip
+    (tmp_path / bench.EPSILON).write_text(json.dumps(record))
+    block = bench.epsilon_block(tmp_path)
+    assert "| seed0 | 0.700: 50 / 20 | 0.650: 55 / 20 |" in block and block.endswith("| 0.500 |")
+    assert "10 episodes per case and room on the val rooms" in block
+    assert "chosen thresholds" not in block  # no test run with them yet
