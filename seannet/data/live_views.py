@@ -190,7 +190,7 @@ class LiveRooms:
     def image(self, i: int, j: int, heading: int) -> np.ndarray:
         """The RGB image only, (H, W, 3) uint8 (no id pass: cheaper than :meth:`view`)."""
         _, x, y, theta = self._pose(i, j, heading)
-        rgb, _ = self.renderer.render_rgb(x, y, theta)
+        rgb, _ = self.renderer.render_rgb(x, y, theta, depth=False)
         return self._stored(rgb)
 
     def tensors(self, record: Any, transform: ImageTransform) -> ViewTensors:

@@ -78,7 +78,7 @@ class ViewAnnotator:
             raise RenderError("no layout loaded: call ViewAnnotator.set_layout first")
         table, cam = self._table, self.camera
         rng = np.random.default_rng(seed) if jitter_lights else None
-        rendered = self.renderer.render(pose.x, pose.y, pose.theta, rng=rng)
+        rendered = self.renderer.render(pose.x, pose.y, pose.theta, rng=rng, depth=self.keep_depth)
         ann = annotate(rendered, table, min_visible_pixels=self.min_visible_pixels)
         rows = ann.rows
         classes = [table.class_name[r] for r in rows]

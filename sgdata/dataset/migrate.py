@@ -1,23 +1,36 @@
-"""``sgdata migrate``: rewrite a dataset of an older format (1.x) in the current one, in place.
+"""``sgdata migrate``: rewrite a dataset of an older format in the current one, in place.
 
 Reading needs no migration (:func:`~sgdata.dataset.reader.read_table` reads 1.x files as they
 are); migrating is for the tools that read the files with no sgdata code: ``datasets`` decodes
 images only from the 2.x storage, and only 2.x has the card and ``croissant.json``. Each table
 is read through the reader (1.x images, columns a later minor added as nulls) and written again
 with :func:`~sgdata.dataset.rows.write_parquet`; the manifest is written last, so a run that
-stops half way leaves a dataset that still reads, and running again finishes it.
+stops half way leaves a dataset that still reads, and running again finishes it. PNG images of
+a dataset older than :data:`~sgdata.dataset.rows.PNG_STRATEGY_SINCE` are decoded and encoded
+again as ``generate`` now encodes them (lossless: the same pixels); JPEGs are kept as they are.
 """
 
 from __future__ import annotations
 
+import io
 from dataclasses import replace
 from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+from PIL import Image
 
 from sgdata.dataset.manifest import FileEntry, Manifest, read_manifest, write_manifest
 from sgdata.dataset.paths import observations_path, triplets_path
 from sgdata.dataset.reader import read_table
-from sgdata.dataset.rows import write_parquet
-from sgdata.dataset.schema import FORMAT_VERSION, observations_schema, triplets_schema
+from sgdata.errors import DatasetError
+from sgdata.dataset.rows import PNG_STRATEGY_SINCE, encode_image, write_parquet
+from sgdata.dataset.schema import (
+    FORMAT_VERSION,
+    _parse_version,
+    observations_schema,
+    triplets_schema,
+)
 
 __all__ = ["migrate_dataset"]
 
@@ -47,12 +60,33 @@ def migrate_dataset(root: str | Path) -> Manifest:
         for r in rs
     }
     tables |= {triplets_path(s): triplets_schema() for s in manifest.splits}
+    old_png = _parse_version(manifest.format_version) < _parse_version(PNG_STRATEGY_SINCE)
     files = []
     for entry in manifest.files:
         schema = tables.get(entry.path)
         if schema is not None:
-            info = write_parquet(read_table(root / entry.path, schema), root / entry.path)
+            table = read_table(root / entry.path, schema)
+            if old_png and "image" in table.column_names:
+                table = _reencode_pngs(table, entry.path)
+            info = write_parquet(table, root / entry.path)
             entry = FileEntry(entry.path, info.rows, info.sha256, info.bytes)
         files.append(entry)
     write_manifest(replace(manifest, format_version=FORMAT_VERSION, files=tuple(files)), root)
     return read_manifest(root)
+
+
+def _reencode_pngs(table: pa.Table, where: str) -> pa.Table:
+    """The observation table with its PNG images encoded as ``generate`` encodes them now."""
+    images = table.column("image").to_pylist()
+    formats = table.column("image_format").to_pylist()
+    out = []
+    for data, fmt in zip(images, formats, strict=True):
+        if fmt == "png":
+            try:
+                with Image.open(io.BytesIO(data)) as image:
+                    data = encode_image(np.asarray(image.convert("RGB")), "png")
+            except OSError as exc:
+                raise DatasetError(f"{where}: an image does not decode as PNG ({exc})") from None
+        out.append(data)
+    at = table.schema.get_field_index("image")
+    return table.set_column(at, table.schema.field(at), pa.array(out, type=pa.binary()))

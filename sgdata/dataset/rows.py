@@ -13,6 +13,7 @@ import hashlib
 import io
 import os
 import tempfile
+import zlib
 from collections.abc import Collection, Sequence
 from pathlib import Path
 from typing import NamedTuple
@@ -31,6 +32,7 @@ from sgdata.world.triplets import Triplet
 
 __all__ = [
     "IMAGE_FORMATS",
+    "PNG_STRATEGY_SINCE",
     "PARQUET_OPTIONS",
     "ParquetInfo",
     "encode_image",
@@ -41,6 +43,10 @@ __all__ = [
 ]
 
 IMAGE_FORMATS = ("png", "jpeg")
+# PNGs are deflated with zlib's run-length strategy since format 2.0.1: on rendered views it
+# encodes 4x faster than the default strategy for 4 % more bytes (docs/benchmarks.md); the
+# pixels are the same, only the bytes differ, so `sgdata migrate` re-encodes older PNGs.
+PNG_STRATEGY_SINCE = "2.0.1"
 DOMAIN_SYNTHETIC = "synthetic"
 # Fixed writer options: the same table always gives the same bytes (for a given pyarrow).
 # 256 rows per row group keeps random access to one view cheap for data loaders.
@@ -72,7 +78,9 @@ def encode_image(rgb: np.ndarray, image_format: str = "png", *, jpeg_quality: in
     buffer = io.BytesIO()
     image = Image.fromarray(np.ascontiguousarray(rgb), mode="RGB")
     if image_format == "png":
-        image.save(buffer, format="PNG", optimize=False, compress_level=6)
+        image.save(
+            buffer, format="PNG", optimize=False, compress_level=6, compress_type=zlib.Z_RLE
+        )
     else:
         # 4:2:0 subsampling and no progressive/optimize passes: fixed, widely decodable output.
         image.save(buffer, format="JPEG", quality=int(jpeg_quality), subsampling=2, optimize=False)

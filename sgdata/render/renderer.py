@@ -10,11 +10,9 @@ object nodes of the id scene; only a different instance set rebuilds everything.
 Instance ids come from one of two id passes (``id_pass``), both exact (no blended values):
 
 - ``"raster"`` (default): pyrender's SEG pass with each object's dense index encoded in a
-  flat 24-bit colour (structure encodes 0, so walls occlude). pyrender draws it into its 4x
-  multisampled framebuffer but with ``GL_MULTISAMPLE`` disabled; by the GL spec every sample
-  of a pixel then receives the same fragment, so the resolve blit averages equal values and
-  stays exact (checked: no code outside the known set on llvmpipe). Decoded codes are still
-  validated against the known range on every view and a bad one raises ``RenderError``.
+  flat 24-bit colour (structure encodes 0, so walls occlude), drawn into a single-sample
+  framebuffer (:mod:`sgdata.render.target`), so no value is ever blended. Decoded codes are
+  still validated against the known range on every view and a bad one raises ``RenderError``.
 - ``"raycast"``: open3d's ``RaycastingScene`` casts one ray through the centre of every
   pixel (the rasteriser's sample point) and a lookup table maps the hit triangle to its
   object: integers all the way.
@@ -46,8 +44,6 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Iterator
-from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any, Literal
 
@@ -63,6 +59,7 @@ from sgdata.render.primitives import (
     subset,
     untextured,
 )
+from sgdata.render.target import use_single_sample_target
 from sgdata.usd.meshes import Lighting, MeshData, SceneGeometry
 
 __all__ = ["RenderedView", "Renderer", "use_egl_platform"]
@@ -139,6 +136,7 @@ class Renderer:
             self._pr = pyrender
             self._gl = pyrender.OffscreenRenderer(self.camera.width, self.camera.height)
             self._gl._renderer._sorted_mesh_nodes = self._draw_order
+            self._target = use_single_sample_target(self._gl._renderer)
             Renderer._open += 1
         except Exception as exc:  # any failure here is an environment problem, not a bug
             why = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
@@ -274,20 +272,32 @@ class Renderer:
     # -- rendering --------------------------------------------------------------------------
 
     def render(
-        self, x: float, y: float, theta: float, *, rng: np.random.Generator | None = None
+        self,
+        x: float,
+        y: float,
+        theta: float,
+        *,
+        rng: np.random.Generator | None = None,
+        depth: bool = True,
     ) -> RenderedView:
         """RGB, instance ids and depth from the agent pose (x, y, heading ``theta`` rad).
 
         ``rng`` jitters light intensities by up to +-20 % (off when None), on top of the
-        stage's own light.
+        stage's own light. ``depth=False`` skips reading depth back (the view's depth is None).
         """
-        rgb, depth = self.render_rgb(x, y, theta, rng=rng)
-        return RenderedView(rgb=rgb, instance=self.render_ids(x, y, theta), depth=depth)
+        rgb, metres = self.render_rgb(x, y, theta, rng=rng, depth=depth)
+        return RenderedView(rgb=rgb, instance=self.render_ids(x, y, theta), depth=metres)
 
     def render_rgb(
-        self, x: float, y: float, theta: float, *, rng: np.random.Generator | None = None
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """The RGB pass only: (rgb uint8 HxWx3, depth float32 HxW)."""
+        self,
+        x: float,
+        y: float,
+        theta: float,
+        *,
+        rng: np.random.Generator | None = None,
+        depth: bool = True,
+    ) -> tuple[np.ndarray, np.ndarray | None]:
+        """The RGB pass only: (rgb uint8 HxWx3, depth float32 HxW or None if not ``depth``)."""
         self._require_scene()
         scale = self._lighting.intensity
         key, fill = self.key_intensity * scale, self.fill_intensity * scale
@@ -300,9 +310,9 @@ class Renderer:
         key_pose = pose.copy()  # tilt the head light 15 deg further down than the view
         key_pose[:3, :3] = pose[:3, :3] @ _rot_x(-math.radians(15.0))
         self._scene.set_pose(self._key_node, key_pose)
-        with _multisampling_off():
-            rgb, depth = self._gl.render(self._scene, flags=self._pr.RenderFlags.NONE)
-        return np.ascontiguousarray(rgb), depth
+        self._target.depth = depth
+        rgb, metres = self._gl.render(self._scene, flags=self._pr.RenderFlags.NONE)
+        return np.ascontiguousarray(rgb), metres
 
     def render_ids(
         self,
@@ -408,6 +418,7 @@ class Renderer:
     def _raster_index(self, x: float, y: float, theta: float) -> np.ndarray:
         self._scene.set_pose(self._cam_node, self.camera.pose_matrix(x, y, theta))
         self._show_object_nodes(True)
+        self._target.depth = False
         try:
             color, _ = self._gl.render(
                 self._scene, flags=self._pr.RenderFlags.SEG, seg_node_map=self._seg_map
@@ -471,34 +482,6 @@ class Renderer:
         prim = hit["primitive_ids"].numpy().astype(np.int64)
         prim[prim >= len(self._face_owner) - 1] = len(self._face_owner) - 1  # misses
         return self._face_owner[prim].reshape(cam.height, cam.width)
-
-
-@contextmanager
-def _multisampling_off() -> Iterator[None]:
-    """Make pyrender's RGB pass disable GL_MULTISAMPLE where it would enable it.
-
-    llvmpipe's multisample path is not deterministic: the same view rendered in fresh
-    processes differed in one edge pixel in 2 of 7 runs, never in 11 runs without it. Byte-
-    identical datasets matter more than anti-aliased edges (the speed is the same, 12 fps).
-    pyrender has no switch for it, so its module's ``glEnable`` is wrapped for the call. The
-    wrapper disables rather than skips: a fresh GL context starts with multisampling on.
-    """
-    import pyrender.renderer as pyrender_renderer
-    from OpenGL.GL import GL_MULTISAMPLE, glDisable
-
-    original = pyrender_renderer.glEnable
-
-    def enable(capability: int) -> None:
-        if capability == GL_MULTISAMPLE:
-            glDisable(GL_MULTISAMPLE)
-        else:
-            original(capability)
-
-    pyrender_renderer.glEnable = enable
-    try:
-        yield
-    finally:
-        pyrender_renderer.glEnable = original
 
 
 def _ceiling_light_pose(scene: SceneGeometry) -> np.ndarray:

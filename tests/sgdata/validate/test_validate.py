@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import io
 import json
 import shutil
 import subprocess
@@ -10,10 +11,12 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
 import pyarrow as pa
 import pyarrow.compute as pc
 import pyarrow.parquet as pq
 import pytest
+from PIL import Image
 
 from sgdata.dataset import Dataset, read_manifest, write_manifest, write_parquet
 from sgdata.errors import DatasetError
@@ -59,29 +62,55 @@ def rewrite(root: Path, rel: str, table: pa.Table, *, update_manifest: bool = Tr
         write_manifest(read_manifest(root), root)
 
 
-def legacy_dataset(root: Path, *, drop: tuple[str, ...] | list[str] = ()) -> None:
-    """Turn a generated dataset into a format 1.1.0 one, as sgdata 1.x wrote it: images as bare
-    bytes (non-null binary, no huggingface metadata), no card, no croissant.json."""
+def deflated_the_old_way(png: bytes) -> bytes:
+    """A PNG as formats before 2.0.1 wrote it: zlib's default strategy, level 6."""
+    buffer = io.BytesIO()
+    with Image.open(io.BytesIO(png)) as image:
+        image.save(buffer, format="PNG", optimize=False, compress_level=6)
+    return buffer.getvalue()
+
+
+def legacy_dataset(
+    root: Path, *, drop: tuple[str, ...] | list[str] = (), version: str = "1.1.0"
+) -> None:
+    """Turn a generated dataset into one of an older format, as that sgdata wrote it: PNGs
+    deflated the old way and, for 1.x, images as bare bytes (non-null binary, no huggingface
+    metadata), no card, no croissant.json."""
     raw = json.loads((root / "dataset.json").read_text())
+    bare = version.startswith("1.")
     files = []
     for entry in raw["files"]:
         path = root / entry["path"]
-        if entry["path"] in ("README.md", "croissant.json"):
+        if bare and entry["path"] in ("README.md", "croissant.json"):
             path.unlink()
             continue
         if entry["path"].startswith("observations/"):
             table = pq.read_table(path).drop_columns(list(drop))
             at = table.schema.get_field_index("image")
-            doc = {b"doc": table.schema.field("image").metadata[b"doc"]}
-            field = pa.field("image", pa.binary(), nullable=False, metadata=doc)
-            table = table.set_column(at, field, pc.struct_field(table.column("image"), "bytes"))
-            metadata = {k: v for k, v in table.schema.metadata.items() if k != b"huggingface"}
+            old = [
+                {"bytes": deflated_the_old_way(cell["bytes"]), "path": None}
+                for cell in table.column("image").to_pylist()
+            ]
+            column = pa.array(old, type=table.schema.field(at).type)
+            table = table.set_column(at, table.schema.field(at), column)
+            metadata = table.schema.metadata
+            if bare:
+                doc = {b"doc": table.schema.field("image").metadata[b"doc"]}
+                field = pa.field("image", pa.binary(), nullable=False, metadata=doc)
+                table = table.set_column(at, field, pc.struct_field(column, "bytes"))
+                metadata = {k: v for k, v in metadata.items() if k != b"huggingface"}
             pq.write_table(table.replace_schema_metadata(metadata), path)
             digest = hashlib.sha256(path.read_bytes()).hexdigest()
             entry.update(sha256=digest, bytes=path.stat().st_size)
         files.append(entry)
-    raw.update(files=files, format_version="1.1.0")
+    raw.update(files=files, format_version=version)
     (root / "dataset.json").write_text(json.dumps(raw, indent=2))
+    if not bare:  # the card and croissant.json of that dataset, as its writer made them
+        write_manifest(read_manifest(root), root)
+
+
+def pixels(images: pa.ChunkedArray) -> list[np.ndarray]:
+    return [np.asarray(Image.open(io.BytesIO(b))) for b in images.to_pylist()]
 
 
 def rows_of(root: Path, rel: str) -> tuple[list[dict], pa.Schema]:
@@ -374,10 +403,11 @@ def test_a_format_1_1_dataset_reads_validates_and_migrates(copy: Path, mini_data
     assert {"metadata.card", "metadata.croissant"} <= set(report.skipped)
     old, new = Dataset.open(copy), Dataset.open(mini_dataset)
     assert old.manifest.format_version == "1.1.0"  # read as it is, not renamed
-    columns = ["obs_id", "image"]
-    assert old.observations("train", columns=columns).equals(
-        new.observations("train", columns=columns)
-    )
+    before, after = old.observations("train"), new.observations("train")
+    assert before.drop_columns(["image"]).equals(after.drop_columns(["image"]))
+    assert not before.column("image").equals(after.column("image"))  # other bytes, same pixels
+    for a, b in zip(pixels(before.column("image")), pixels(after.column("image")), strict=True):
+        assert np.array_equal(a, b)
 
     cli = [sys.executable, "-m", "sgdata_cli.sgdata_app", "migrate"]  # the command, end to end
     done = subprocess.run([*cli, str(copy)], capture_output=True, text=True, timeout=300)
@@ -394,6 +424,18 @@ def test_a_format_1_1_dataset_reads_validates_and_migrates(copy: Path, mini_data
     done = subprocess.run([*cli, str(copy / "scenes")], capture_output=True, text=True)
     assert done.returncode != 0 and "no dataset.json" in done.stderr
     assert len(done.stderr.strip().splitlines()) == 1
+
+
+def test_a_format_2_0_0_dataset_migrates_to_the_bytes_generate_writes(
+    copy: Path, mini_dataset: Path
+) -> None:
+    from sgdata.dataset import FORMAT_VERSION, Dataset, migrate_dataset
+
+    legacy_dataset(copy, version="2.0.0")  # the old PNG deflate, everything else as now
+    assert validate_dataset(copy).ok
+    assert migrate_dataset(copy).format_version == FORMAT_VERSION
+    generated = {f.path: f.sha256 for f in Dataset.open(mini_dataset).manifest.files}
+    assert {f.path: f.sha256 for f in read_manifest(copy).files} == generated
 
 
 def test_card_and_croissant_that_disagree_are_reported(copy: Path) -> None:
