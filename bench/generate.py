@@ -2,6 +2,7 @@
 
     .venv/bin/python bench/generate.py                 # 1 vs 2 workers, 2 / 4 / 8 rooms
     .venv/bin/python bench/generate.py --rooms 2 4 8 16
+    .venv/bin/python bench/generate.py --preset medium --workers 8 16   # a preset, whole
 
 For each room count it runs a fresh process that generates a dataset of that many rooms
 (kitchens and bathrooms, 3 layouts, 24 triplets per room, 224 x 224) and prints views/s of
@@ -39,14 +40,16 @@ test = 0
 """
 
 
-def run_one(rooms: int, workers: int, executor: str = "local") -> dict:
-    """Generate in this process; report counts, times and peak memory (MiB)."""
+def run_one(rooms: int, workers: int, executor: str = "local", preset: str | None = None) -> dict:
+    """Generate in this process (``preset`` whole, or ``rooms`` rooms of the bench config);
+    report counts, times and peak memory (MiB)."""
     from sgdata.pipeline.config import load_config
     from sgdata.pipeline.generate import generate_dataset
 
     with tempfile.TemporaryDirectory() as tmp:
         config_path = Path(tmp) / "bench.toml"
         config_path.write_text(CONFIG.format(per_type=rooms // 2, triplets=24 * rooms))
+        config = load_config(preset or config_path)
         phases: dict[str, float] = {}
 
         def progress(step) -> None:  # noqa: ANN001
@@ -55,7 +58,7 @@ def run_one(rooms: int, workers: int, executor: str = "local") -> dict:
 
         start = time.perf_counter()
         manifest = generate_dataset(
-            load_config(config_path),
+            config,
             Path(tmp) / "data",
             workers=workers,
             executor=executor,
@@ -64,7 +67,7 @@ def run_one(rooms: int, workers: int, executor: str = "local") -> dict:
         wall = time.perf_counter() - start
     views = sum(manifest["counts"]["observations"].values())
     return {
-        "rooms": rooms,
+        "rooms": sum(len(r) for r in manifest["splits"].values()),
         "workers": workers,
         "executor": executor,
         "views": views,
@@ -81,13 +84,14 @@ def main() -> None:
     parser.add_argument("--rooms", type=int, nargs="+", default=[2, 4, 8])
     parser.add_argument("--workers", type=int, nargs="+", default=[1, 2])
     parser.add_argument("--executor", default="local", choices=["local", "ray"])
+    parser.add_argument("--preset", help="generate this preset whole (--rooms is then ignored)")
     parser.add_argument("--one", nargs=2, type=int, help=argparse.SUPPRESS)  # rooms workers
     args = parser.parse_args()
     if args.one:
-        print(json.dumps(run_one(*args.one, executor=args.executor)))
+        print(json.dumps(run_one(*args.one, executor=args.executor, preset=args.preset)))
         return
     rows = []
-    for rooms in args.rooms:
+    for rooms in [0] if args.preset else args.rooms:
         for workers in args.workers:
             # a fresh process per measurement, so peak memory is that run's alone
             out = subprocess.run(
@@ -99,6 +103,7 @@ def main() -> None:
                     str(workers),
                     "--executor",
                     args.executor,
+                    *(["--preset", args.preset] if args.preset else []),
                 ],
                 capture_output=True,
                 text=True,
@@ -117,7 +122,7 @@ def main() -> None:
             f"| {r['rooms']} | {r['workers']} | {r['views']} | {r['wall_s']} | {r['views_per_s']} "
             f"| {r['render_views_per_s']} | {r['main_peak_mib']} | {r['worker_peak_mib']} |"
         )
-    for rooms in args.rooms:
+    for rooms in sorted({r["rooms"] for r in rows}):
         by_workers = {r["workers"]: r for r in rows if r["rooms"] == rooms}
         if 1 in by_workers and 2 in by_workers:
             ratio = by_workers[2]["views_per_s"] / by_workers[1]["views_per_s"]

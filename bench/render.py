@@ -9,10 +9,12 @@ plain pyrender (one node per object, an RGB and a SEG pass) on the same views.
 Prints frames per second of the RGB pass, the id pass, both (what the pipeline must do) and
 the full pipeline (render -> annotate -> slots -> relations), and the pipeline's ratio to the
 bare passes (target >= 0.85). Generated rooms are written textured (``[appearance]``
-defaults): ``rgb``, ``pipeline`` and the plain-pyrender rows draw them flat, as before
-textures existed; ``rgb_textured`` and ``pipeline_textured`` draw their textures, on the same
-views, flat and textured measured in turn twice (ABAB) so that a busy machine skews both
-alike; ``textured/flat`` is the pipeline's ratio (target >= 0.8: at most 20 % slower).
+defaults): ``rgb``, ``pipeline`` and ``naive`` (plain pyrender) draw them flat, as before
+textures existed; ``rgb_textured``, ``pipeline_textured`` and ``naive_textured`` draw their
+textures, on the same views, flat and textured measured in turn twice (ABAB) so that a busy
+machine skews both alike; ``textured/flat`` is the pipeline's ratio (target >= 0.8: at most
+20 % slower), ``textured: pipeline/naive`` the headline against plain pyrender on the default
+(textured) views (target >= 2).
 """
 
 from __future__ import annotations
@@ -85,7 +87,8 @@ def sample_poses(room: Room, count: int, rng: np.random.Generator) -> list[ViewP
 
 class NaivePyrender:
     """pyrender used as its documentation shows: the structure and one node per object (its
-    local mesh under its pose), two lights, an RGB pass and a SEG pass (instance colours).
+    local mesh under its pose, drawn with its textures when ``textured``), two lights, an RGB
+    pass and a SEG pass (instance colours), in pyrender's own (multisampled) framebuffer.
 
     Its GL context lives as long as the process: pyrender's ``delete`` terminates the EGL
     display every renderer of the process shares.
@@ -96,18 +99,28 @@ class NaivePyrender:
 
         self.camera, self.pr = camera, pr
         self.gl = pr.OffscreenRenderer(camera.width, camera.height)
+        self.textures: dict[str, object] = {}  # file -> pyrender texture, decoded once
 
-    def load(self, geometry: SceneGeometry) -> None:
-        from sgdata.render.primitives import primitive
+    def load(self, geometry: SceneGeometry, *, textured: bool = False) -> None:
+        from sgdata.render.primitives import mesh_primitives, texture
         from sgdata.render.renderer import _ceiling_light_pose
 
         pr, camera = self.pr, self.camera
+
+        def texture_of(path: str) -> object:
+            if path not in self.textures:
+                self.textures[path] = texture(pr, path)
+            return self.textures[path]
+
+        def mesh(m: object, **kwargs: bool) -> object:
+            return pr.Mesh(mesh_primitives(pr, m, texture_of if textured else None, **kwargs))
+
         scene = pr.Scene(bg_color=[0.45, 0.45, 0.48, 1.0], ambient_light=[0.35] * 3)
         seg = {}
         for m in geometry.structure:
-            seg[scene.add(pr.Mesh([primitive(pr, m, double_sided=True)]))] = np.zeros(3)
+            seg[scene.add(mesh(m, double_sided=True))] = np.zeros(3)
         for k, obj in enumerate(geometry.objects, 1):
-            node = scene.add(pr.Mesh([primitive(pr, obj.mesh)]), pose=np.asarray(obj.matrix))
+            node = scene.add(mesh(obj.mesh), pose=np.asarray(obj.matrix))
             seg[node] = np.array([k & 255, (k >> 8) & 255, k >> 16])
         cam = pr.PerspectiveCamera(yfov=camera.yfov, aspectRatio=camera.width / camera.height)
         self.cam_node = scene.add(cam)
@@ -149,7 +162,16 @@ def main() -> None:
     naive = NaivePyrender(renderer.camera)
     annotator = ViewAnnotator(renderer, slots)
     rng = np.random.default_rng(args.seed)
-    keys = ("rgb", "ids", "rgb+ids", "pipeline", "naive", "rgb_textured", "pipeline_textured")
+    keys = (
+        "rgb",
+        "ids",
+        "rgb+ids",
+        "pipeline",
+        "naive",
+        "rgb_textured",
+        "pipeline_textured",
+        "naive_textured",
+    )
     totals: dict[str, list[float]] = {k: [] for k in keys}
 
     def draw(textured: bool) -> None:
@@ -175,8 +197,11 @@ def main() -> None:
             runs[key].append(rate(lambda p: annotator.view(p), poses))
         fps["rgb_textured"] = rate(lambda p: renderer.render_rgb(p.x, p.y, p.theta), poses)
         fps.update({k: float(np.mean(v)) for k, v in runs.items()})
-        naive.load(geometry)
-        fps["naive"] = rate(naive.view, poses)
+        naive_runs: dict[str, list[float]] = {"naive": [], "naive_textured": []}
+        for textured in (False, True, False, True):
+            naive.load(geometry, textured=textured)
+            naive_runs["naive_textured" if textured else "naive"].append(rate(naive.view, poses))
+        fps.update({k: float(np.mean(v)) for k, v in naive_runs.items()})
         for key, value in fps.items():
             totals[key].append(value)
         objs = len(geometry.objects)
@@ -188,6 +213,7 @@ def main() -> None:
     if totals["pipeline"]:
         mean = {k: float(np.mean(v)) for k, v in totals.items()}
         mean["pipeline/naive"] = mean["pipeline"] / mean["naive"]
+        mean["textured: pipeline/naive"] = mean["pipeline_textured"] / mean["naive_textured"]
         mean["pipeline/(rgb+ids)"] = mean["pipeline"] / mean["rgb+ids"]
         mean["textured/flat"] = mean["pipeline_textured"] / mean["pipeline"]
         if args.json:

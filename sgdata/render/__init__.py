@@ -9,7 +9,6 @@ _EXPORTS = {
     "same_mesh": ".primitives",
     "same_shape": ".primitives",
     "subset": ".primitives",
-    "untextured": ".primitives",
     "RenderedView": ".renderer",
     "Renderer": ".renderer",
     "use_egl_platform": ".renderer",

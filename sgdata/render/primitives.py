@@ -7,14 +7,25 @@ the face colours (pyrender multiplies ``COLOR_0`` into the lit colour, in linear
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
+from sgdata.errors import RenderError
 from sgdata.usd.meshes import MeshData, ObjectGeometry, merge_meshes
 
-__all__ = ["merged_world", "primitive", "same_mesh", "same_shape", "subset", "untextured"]
+__all__ = [
+    "face_order",
+    "merged_world",
+    "mesh_primitives",
+    "primitive",
+    "same_mesh",
+    "same_shape",
+    "subset",
+    "texture",
+]
 
 
 def merged_world(objects: tuple[ObjectGeometry, ...]) -> MeshData:
@@ -45,11 +56,6 @@ def same_mesh(a: MeshData, b: MeshData) -> bool:
 
 def _equal_or_none(a: np.ndarray | None, b: np.ndarray | None) -> bool:
     return (a is None and b is None) or (a is not None and b is not None and np.array_equal(a, b))
-
-
-def untextured(mesh: MeshData) -> MeshData:
-    """The mesh without its textures (the id pass needs shapes only)."""
-    return replace(mesh, uvs=None, face_texture=None, textures=())
 
 
 def subset(mesh: MeshData, pick: np.ndarray) -> MeshData:
@@ -90,3 +96,49 @@ def primitive(pr: Any, mesh: MeshData, *, double_sided: bool = False, texture: A
         color_0=np.repeat(colors, 3, axis=0),
         material=material,
     )
+
+
+def face_order(mesh: MeshData, textured: bool) -> np.ndarray:
+    """The order the RGB pass draws a mesh's faces in: untextured faces first, then those of
+    each texture file in file order (one primitive each), each group in mesh order; all in
+    mesh order when not ``textured``."""
+    if not (textured and mesh.textured):
+        return np.arange(len(mesh.faces))
+    which = np.asarray(mesh.face_texture)
+    return np.concatenate(
+        [np.flatnonzero(which < 0)] + [np.flatnonzero(which == k) for k in range(len(mesh.textures))]
+    )
+
+
+def mesh_primitives(
+    pr: Any,
+    mesh: MeshData,
+    texture_of: Callable[[str], Any] | None,
+    *,
+    double_sided: bool = False,
+) -> list[Any]:
+    """The RGB primitives of a mesh in :func:`face_order`: one for its untextured faces, one
+    per texture file. ``texture_of`` maps a texture file to its pyrender texture; None draws
+    every face in its flat colour."""
+    if texture_of is None or not mesh.textured:
+        return [primitive(pr, mesh, double_sided=double_sided)]
+    which = np.asarray(mesh.face_texture)
+    out = []
+    for k in (-1, *range(len(mesh.textures))):
+        pick = which < 0 if k < 0 else which == k
+        if pick.any():
+            texture = None if k < 0 else texture_of(mesh.textures[k])
+            out.append(primitive(pr, subset(mesh, pick), double_sided=double_sided, texture=texture))
+    return out
+
+
+def texture(pr: Any, path: str) -> Any:
+    """The pyrender texture of an image file (decoded here; callers keep one per file)."""
+    from PIL import Image
+
+    try:
+        with Image.open(path) as image:
+            pixels = np.asarray(image.convert("RGB"), dtype=np.uint8)
+    except OSError as exc:
+        raise RenderError(f"{path}: cannot read texture image ({exc})") from None
+    return pr.Texture(source=pixels, source_channels="RGB")

@@ -4,23 +4,24 @@ The RGB pass draws the room's structure and all objects merged into one world-sp
 on llvmpipe pyrender's per-node Python overhead (uniforms and lights bound per primitive)
 cost more than the rasterising itself, and merging took a 68-object kitchen from 8 to 20 RGB
 frames/s. A new layout of the same room (:meth:`Renderer.update_poses`) re-merges the kept
-object meshes under the new transforms (numpy only, no recipe or USD work) and moves the
-object nodes of the id scene; only a different instance set rebuilds everything.
+object meshes under the new transforms (numpy only, no recipe or USD work) and uploads them
+to the id pass; only a different instance set rebuilds everything.
 
 Instance ids come from one of two id passes (``id_pass``), both exact (no blended values):
 
-- ``"raster"`` (default): pyrender's SEG pass with each object's dense index encoded in a
-  flat 24-bit colour (structure encodes 0, so walls occlude), drawn into a single-sample
-  framebuffer (:mod:`sgdata.render.target`), so no value is ever blended. Decoded codes are
-  still validated against the known range on every view and a bad one raises ``RenderError``.
+- ``"raster"`` (default): the RGB pass's own triangles drawn in one call with each object's
+  dense index + 1 as a flat 24-bit colour (structure encodes 0, so walls occlude), into a
+  single-sample framebuffer, so no value is ever blended (:mod:`sgdata.render.id_pass`,
+  :mod:`sgdata.render.target`). Decoded codes are still validated against the known range
+  on every view and a bad one raises ``RenderError``.
 - ``"raycast"``: open3d's ``RaycastingScene`` casts one ray through the centre of every
   pixel (the rasteriser's sample point) and a lookup table maps the hit triangle to its
   object: integers all the way.
 
-Measured on 2 llvmpipe cores, 224², a generated 68-object kitchen: raster 20 ids/s, raycast
-15 ids/s (one thread; rays that all hit something are slower than open3d's ~140/s on sparse
-scenes), hence raster by default (see docs/benchmarks.md).
-The two agree except on pixels whose centre lies exactly on a shared edge.
+Raycasting was measured at 15 ids/s against pyrender's SEG pass's 20 (a generated 68-object
+kitchen, 224², one thread; rays that all hit something are slower than open3d's ~140/s on
+sparse scenes), and the one-draw raster pass is faster still, hence raster by default (see
+docs/benchmarks.md). The two agree except on pixels whose centre lies exactly on a shared edge.
 
 EGL: ``PYOPENGL_PLATFORM`` is set to ``egl`` (unless the caller already set it) by
 :func:`use_egl_platform`, called when the first :class:`Renderer` is built, never at import.
@@ -53,12 +54,12 @@ from sgdata.errors import RenderError
 from sgdata.render.camera import CameraConfig
 from sgdata.render.primitives import (
     merged_world,
-    primitive,
+    mesh_primitives,
     same_mesh,
     same_shape,
-    subset,
-    untextured,
+    texture,
 )
+from sgdata.render.id_pass import MergedIdPass
 from sgdata.render.target import use_single_sample_target
 from sgdata.usd.meshes import Lighting, MeshData, SceneGeometry
 
@@ -137,18 +138,17 @@ class Renderer:
             self._gl = pyrender.OffscreenRenderer(self.camera.width, self.camera.height)
             self._gl._renderer._sorted_mesh_nodes = self._draw_order
             self._target = use_single_sample_target(self._gl._renderer)
+            self._ids = MergedIdPass(self._gl._renderer, self._target, self._gl._platform)
             Renderer._open += 1
         except Exception as exc:  # any failure here is an environment problem, not a bug
             why = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
             raise RenderError(_EGL_HINT.format(why=why)) from None
         self._instances: tuple[int, ...] | None = None
-        self._object_nodes: list[Any] = []
         self._meshes: list[MeshData] = []
         self._structure: tuple[MeshData, ...] = ()
         self._scene: Any = None
         self._rank: dict[Any, int] = {}  # mesh node -> the order it was added in
         self._merged_node: Any = None
-        self._seg_map: dict[Any, np.ndarray] = {}
         self._instance_lut = np.full(1, -1, dtype=np.int32)  # dense index + 1 -> instance
         self._rays_cam = self._camera_rays()
         self._rc: Any = None
@@ -163,9 +163,9 @@ class Renderer:
         return self._instances or ()
 
     def load(self, scene: SceneGeometry) -> None:
-        """Build the scenes of a room: the RGB scene draws structure and all objects merged
-        into one world-space mesh (pyrender's per-node overhead dominates on llvmpipe), the
-        id scene keeps one node per object for the SEG pass."""
+        """Build the scene of a room: the structure and all objects merged into one
+        world-space mesh (pyrender's per-node overhead dominates on llvmpipe), drawn by the
+        RGB pass and, as codes, by the id pass."""
         pr = self._pr
         n = len(scene.objects)
         if n + 1 >= _SEG_LIMIT:
@@ -182,7 +182,7 @@ class Renderer:
         self._scene, self._rank = sc, {}
         for m in scene.structure:
             self._add(pr.Mesh(self._primitives(m, double_sided=True)))
-        self._merged_node = self._add(pr.Mesh(self._primitives(merged_world(scene.objects))))
+        self._merge_objects(scene)
         self._cam_node = sc.add(self._camera_model())
         # Key light rides with the camera (faces towards the viewer always read), fill light
         # hangs under the ceiling's centre so tops and fronts of boxes differ in shade. One
@@ -194,18 +194,16 @@ class Renderer:
         self._fill = pr.PointLight(color=np.ones(3), intensity=self.fill_intensity)
         sc.add(self._fill, pose=_ceiling_light_pose(scene))
         self._set_lighting(scene.lighting)
-        # One node per object for the SEG pass, hidden during the RGB pass. Both live in the
-        # one scene: pyrender unloads the GPU buffers of meshes absent from the scene it draws,
-        # so alternating two scenes would re-upload everything every view.
-        zero = np.zeros(3, dtype=np.int64)
-        self._seg_map = {node: zero for node in sc.mesh_nodes if node is not self._merged_node}
-        self._object_nodes = []
-        for code, (mesh, matrix) in enumerate(zip(self._meshes, self._matrices, strict=True), 1):
-            node = self._add(pr.Mesh([primitive(pr, untextured(mesh))]), pose=matrix)
-            node.mesh.is_visible = False
-            self._object_nodes.append(node)
-            self._seg_map[node] = np.array([code & 255, (code >> 8) & 255, code >> 16])
         self._rc = None  # built on the first raycast id pass
+
+    def _merge_objects(self, scene: SceneGeometry) -> None:
+        """All objects in one world-space mesh: the RGB scene's node and the id pass's codes
+        (face ``f`` of object ``k`` carries ``k + 1``)."""
+        merged = merged_world(scene.objects)
+        self._merged_node = self._add(self._pr.Mesh(self._primitives(merged)))
+        counts = [len(o.mesh.faces) for o in scene.objects]
+        owner = np.repeat(np.arange(1, len(counts) + 1, dtype=np.uint32), counts)
+        self._ids.load(scene.structure, merged, owner, textured=self.textures)
 
     def _add(self, node_or_mesh: Any, **kwargs: Any) -> Any:
         """Add to the scene, remembering the order (the draw order's tie-break)."""
@@ -235,9 +233,9 @@ class Renderer:
     def update_poses(self, scene: SceneGeometry) -> bool:
         """Move the loaded objects to a new layout of the same room.
 
-        Returns ``False`` when only poses and looks changed (the merged RGB mesh is re-merged
-        from the new meshes, with their colours and textures; object nodes of the id scene are
-        moved; the light is set), ``True`` when the instance set, an object's shape or the
+        Returns ``False`` when only poses and looks changed (the merged mesh is re-merged from
+        the new meshes, with their colours and textures, and uploaded to the id pass; the
+        light is set), ``True`` when the instance set, an object's shape or the
         structure differed and the scenes were rebuilt.
         """
         same = (
@@ -254,10 +252,8 @@ class Renderer:
         self._matrices = [np.asarray(o.matrix) for o in scene.objects]
         self._scene.remove_node(self._merged_node)
         self._rank.pop(self._merged_node, None)
-        self._merged_node = self._add(self._pr.Mesh(self._primitives(merged_world(scene.objects))))
+        self._merge_objects(scene)
         self._set_lighting(scene.lighting)
-        for node, matrix in zip(self._object_nodes, self._matrices, strict=True):
-            self._scene.set_pose(node, matrix)
         self._rc = None  # rebuilt lazily with the new world vertices
         return False
 
@@ -380,35 +376,14 @@ class Renderer:
         self._scene.ambient_light = self.ambient * lighting.intensity * color
 
     def _primitives(self, mesh: MeshData, *, double_sided: bool = False) -> list[Any]:
-        """The RGB primitives of a mesh: untextured faces first, then one per texture file."""
-        if not (self.textures and mesh.textured):
-            return [primitive(self._pr, mesh, double_sided=double_sided)]
-        which = np.asarray(mesh.face_texture)
-        out = []
-        if (which < 0).any():
-            out.append(primitive(self._pr, subset(mesh, which < 0), double_sided=double_sided))
-        for k, path in enumerate(mesh.textures):
-            pick = which == k
-            if pick.any():
-                texture = self._texture(path)
-                out.append(
-                    primitive(
-                        self._pr, subset(mesh, pick), double_sided=double_sided, texture=texture
-                    )
-                )
-        return out
+        """The RGB primitives of a mesh (textured unless ``textures`` is off)."""
+        texture_of = self._texture if self.textures else None
+        return mesh_primitives(self._pr, mesh, texture_of, double_sided=double_sided)
 
     def _texture(self, path: str) -> Any:
         """The pyrender texture of an image file, decoded once per renderer."""
         if path not in self._texture_cache:
-            from PIL import Image
-
-            try:
-                with Image.open(path) as image:
-                    pixels = np.asarray(image.convert("RGB"), dtype=np.uint8)
-            except OSError as exc:
-                raise RenderError(f"{path}: cannot read texture image ({exc})") from None
-            self._texture_cache[path] = self._pr.Texture(source=pixels, source_channels="RGB")
+            self._texture_cache[path] = texture(self._pr, path)
         return self._texture_cache[path]
 
     def _require_scene(self) -> None:
@@ -416,24 +391,16 @@ class Renderer:
             raise RenderError("no scene loaded: call Renderer.load(scene) before rendering")
 
     def _raster_index(self, x: float, y: float, theta: float) -> np.ndarray:
-        self._scene.set_pose(self._cam_node, self.camera.pose_matrix(x, y, theta))
-        self._show_object_nodes(True)
-        self._target.depth = False
-        try:
-            color, _ = self._gl.render(
-                self._scene, flags=self._pr.RenderFlags.SEG, seg_node_map=self._seg_map
-            )
-        finally:
-            self._show_object_nodes(False)
-        c = color.astype(np.int32)
-        code = c[..., 0] | (c[..., 1] << 8) | (c[..., 2] << 16)
+        pose = self.camera.pose_matrix(x, y, theta)
+        self._scene.set_pose(self._cam_node, pose)
+        camera = self._scene.main_camera_node.camera
+        projection = camera.get_projection_matrix(
+            width=self.camera.width, height=self.camera.height
+        )
+        code = self._ids.draw(np.linalg.inv(pose), projection)  # V and P as pyrender's
         if int(code.max()) >= len(self._instance_lut):
             raise RenderError("id pass returned an unknown colour code (blended ids?)")
         return code
-
-    def _show_object_nodes(self, visible: bool) -> None:
-        for node in self._object_nodes:
-            node.mesh.is_visible = visible
 
     def _camera_rays(self) -> np.ndarray:
         """Per-pixel ray directions through pixel centres in (right, up, forward) coords."""

@@ -1,4 +1,4 @@
-"""The single-sample framebuffer gives the bytes of pyrender's own multisampled one."""
+"""The single-sample framebuffer gives the pixels of pyrender's own multisampled one."""
 
 from __future__ import annotations
 
@@ -31,14 +31,13 @@ def pyrender_own(monkeypatch: pytest.MonkeyPatch, tiny_room: Any) -> Any:
     renderer.close()
 
 
-def test_same_pixels_ids_and_depth_as_pyrenders_framebuffer(
+def test_same_pixels_and_depth_as_pyrenders_framebuffer(
     pyrender_own: Any, tiny_renderer: Renderer, tiny_view: Any
 ) -> None:
     x, y, theta = tiny_view
     for pose in ((x, y, theta), (x + 0.3, y - 0.2, theta + 0.7), (x, y, theta + np.pi)):
         ours, theirs = tiny_renderer.render(*pose), pyrender_own.render(*pose)
         assert ours.rgb.tobytes() == theirs.rgb.tobytes()
-        assert np.array_equal(ours.instance, theirs.instance)
         # depth at the pixel centre, where pyrender's blit took the first sample's (off the
         # centre): equal to float32 rounding, 0 where nothing was drawn in both
         assert ours.depth is not None and np.array_equal(ours.depth > 0, theirs.depth > 0)
