@@ -81,9 +81,9 @@ STAGES: tuple[tuple[str, str, str], ...] = (
     (VIEWS, "object_table", "object table (ObjectTable.from_scene)"),
     (VIEWS, "grid", "pose grid (PosesConfig.grid)"),
     (VIEWS, "rgb_pass", "RGB pass (Renderer.render_rgb, drawing)"),
-    (VIEWS, "rgb_readback", "RGB read-back (resolve, colour + depth read)"),
-    (VIEWS, "id_pass", "id pass (Renderer.render_ids: SEG drawing, decode)"),
-    (VIEWS, "id_readback", "id read-back (resolve, colour + depth read)"),
+    (VIEWS, "rgb_readback", "RGB read-back (SingleSampleTarget.read)"),
+    (VIEWS, "id_pass", "id pass (Renderer.render_ids: one draw, decode)"),
+    (VIEWS, "id_readback", "id read-back (SingleSampleTarget.read)"),
     (VIEWS, "boxes", "visibility + boxes (annotate)"),
     (VIEWS, "slots", "slots (SlotTable.assign)"),
     (VIEWS, "relations", "relations (stored_precision, compute_relations)"),
@@ -178,13 +178,12 @@ def _targets() -> list[tuple[Any, str, str]]:
 
 
 @contextmanager
-def instrumented(clock: StageClock, images: list[np.ndarray], keep: int) -> Iterator[None]:
-    """Every stage's function wrapped in ``clock`` for the block; the first ``keep`` images
-    handed to the encoder are kept in ``images`` (for the PNG side measurement)."""
-    from sgdata.render.renderer import use_egl_platform
-
-    use_egl_platform()  # before pyrender and OpenGL load
-    import pyrender.renderer
+def instrumented(
+    clock: StageClock, images: list[np.ndarray], keep: int, renderer: Any
+) -> Iterator[None]:
+    """Every stage's function wrapped in ``clock`` for the block, and the read-backs of the
+    worker's ``renderer``; the first ``keep`` images handed to the encoder are kept in
+    ``images`` (for the PNG side measurement)."""
     from OpenGL.GL import glFinish
 
     from sgdata.annotate.boxes import ObjectTable
@@ -201,16 +200,19 @@ def instrumented(clock: StageClock, images: list[np.ndarray], keep: int) -> Iter
                 ObjectTable, "from_scene", classmethod(clock.wrap("object_table", from_scene))
             )
         )
-        read = pyrender.renderer.Renderer._read_main_framebuffer
+        # both passes read through the renderer's target: the RGB pass as pyrender's
+        # _read_main_framebuffer (bound when the renderer was built), the id pass directly
+        target, read = renderer._target, renderer._target.read
 
-        def read_back(self: Any, *args: Any, **kwargs: Any) -> Any:
+        def read_back(*args: Any, **kwargs: Any) -> Any:
             glFinish()  # the queued drawing finishes here, booked to the pass that queued it
             where = {"rgb_pass": "rgb_readback", "id_pass": "id_readback"}
             with clock.stage(where.get(clock.current or "", "rgb_readback")):
-                return read(self, *args, **kwargs)
+                return read(*args, **kwargs)
 
+        stack.enter_context(mock.patch.object(target, "read", read_back))
         stack.enter_context(
-            mock.patch.object(pyrender.renderer.Renderer, "_read_main_framebuffer", read_back)
+            mock.patch.object(renderer._gl._renderer, "_read_main_framebuffer", read_back)
         )
         encode = rows.encode_image  # the timed one, patched above
 
@@ -331,7 +333,8 @@ def measure(args: argparse.Namespace) -> dict:
     with tempfile.TemporaryDirectory(prefix="sgdata-stages-") as tmp:
         root = Path(tmp)
         startup = warm_up(config, root, spare, rng)
-        with instrumented(clock, images, args.png_sample):
+        renderer = room_tasks._annotator(config)[0].renderer  # the worker's, cached
+        with instrumented(clock, images, args.png_sample, renderer):
             clock.phase = SCENES
             start = time.perf_counter()
             for task in tasks:
