@@ -2,6 +2,7 @@
 
     python bench/train_step.py DATA [--preset cpu] [--steps 6]
     python bench/train_step.py DATA --profile [--steps 3]   # where SeanNet's step goes
+    python bench/train_step.py DATA --graph-hidden 1024 512 # SeanNet with a narrower GCN fc
 
 Times, on real triplet batches of DATA's train split (image cache on), a whole training step
 (three embeddings, triplet loss, backward, SGD) of ``seannet`` and ``resnet18``, then the
@@ -14,6 +15,8 @@ docs/benchmarks.md.
 backward of each top-level part of the model (image trunk, head, object features and fcn, the
 GCN pathways, the GCN's fc, fusion, layout pathway), the loss and the optimiser, with each
 part's parameter count. ``--batch-size`` overrides the preset's batch (a quick look).
+``--graph-hidden`` adds, after the two, SeanNet's step with each of these hidden widths of the
+GCN's fc (``ModelConfig.graph_hidden``; 4,096 is the paper's), each against ResNet-18's.
 """
 
 from __future__ import annotations
@@ -55,6 +58,9 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=6)
     parser.add_argument("--profile", action="store_true", help="SeanNet's step, part by part")
     parser.add_argument("--batch-size", type=int, help="triplets a batch (default: the preset's)")
+    parser.add_argument(
+        "--graph-hidden", type=int, nargs="*", default=[], help="SeanNet's GCN fc widths to add"
+    )
     args = parser.parse_args()
     torch.manual_seed(0)
     if args.profile:
@@ -64,8 +70,11 @@ def main() -> None:
         print(profile_report(profile_step(config, args.data, args.steps), config))
         return
     figures = {}
-    for name in ("resnet18", "seannet"):
-        config = preset(args.preset).replace(model=name)
+    variants = [("resnet18", {}), ("seannet", {})]
+    variants += [(f"seannet, graph_hidden {w}", {"graph_hidden": w}) for w in args.graph_hidden]
+    for label, changes in variants:
+        name = label.split(",")[0]
+        config = preset(args.preset).replace(model=name, **changes)
         if args.batch_size:
             config = config.replace(batch_size=args.batch_size)
         model = build_for_dataset(config, args.data).train()
@@ -82,17 +91,20 @@ def main() -> None:
             loss.backward()
             optimiser.step()
 
-        figures[name] = seconds_per_call(step, args.steps)
-        print(f"{name:9s} training step, batch {config.batch_size}: {figures[name]:.3f} s")
-        if isinstance(model, SeanNet):
+        figures[label] = seconds_per_call(step, args.steps)
+        print(f"{label} training step, batch {config.batch_size}: {figures[label]:.3f} s")
+        if changes:
+            ratio = figures[label] / figures["resnet18"]
+            print(f"  {label} / resnet18 step: {ratio:.2f}x")
+        elif isinstance(model, SeanNet):
             graph_forms(model, batches[0][0], args.steps)
             with dense_gcn(model):
                 dense_step = seconds_per_call(step, args.steps)
             print(
                 f"  the same step with the dense GCN: {dense_step:.3f} s "
-                f"({dense_step / figures[name]:.2f}x the present-nodes step)"
+                f"({dense_step / figures[label]:.2f}x the present-nodes step)"
             )
-    print(f"seannet / resnet18 step: {figures['seannet'] / figures['resnet18']:.2f}x")
+            print(f"seannet / resnet18 step: {figures['seannet'] / figures['resnet18']:.2f}x")
 
 
 @contextmanager

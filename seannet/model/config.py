@@ -33,6 +33,9 @@ class ModelConfig:
     # the 5th-stage map computed once per image: no head pass per object)
     visual_features: str = "c4_head"
     embed_dim: int = 2048
+    # hidden width of the GCN's fc (M x 24 -> graph_hidden -> embed_dim); 4096 is the paper's,
+    # and its 25 M weights are a fifth of a CPU training step (docs/benchmarks.md)
+    graph_hidden: int = 4096
     # cells per side of SeanNet's layout pathway (the scene graph's boxes slot by slot,
     # seannet.model.layers.SlotLayout); 0 leaves the paper's graph branch (GCN pathways only)
     layout_grid: int = 32
@@ -42,7 +45,7 @@ class ModelConfig:
     dropout: float = 0.2  # on the GCN layers (paper §V-B)
 
     def __post_init__(self) -> None:
-        for name in ("depth", "image_size", "roi_size", "embed_dim"):
+        for name in ("depth", "image_size", "roi_size", "embed_dim", "graph_hidden"):
             if getattr(self, name) < 1:
                 raise ModelError(f"model.{name} must be >= 1, got {getattr(self, name)}")
         if self.visual_features not in VISUAL_FEATURES:

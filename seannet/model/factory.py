@@ -97,6 +97,7 @@ def build_model(
         num_slots=num_slots,
         roi_size=config.roi_size,
         embed_dim=config.embed_dim,
+        graph_hidden_dim=config.graph_hidden,
         dropout=config.dropout,
         pretrained=pretrained,
         pretrained_sha256=pretrained_sha256,

@@ -96,3 +96,21 @@ def test_graph_only_seannet_learns(tmp_path: Path, mini_dataset: Path, layout_gr
     results = train(config, mini_dataset, tmp_path / "graph")
     assert results[-1].train_loss < results[0].train_loss
     assert max(r.train_accuracy for r in results[-2:]) > 0.6
+
+
+def test_graph_hidden_sets_the_fc_width_and_a_train_config_carries_it() -> None:
+    from seannet.errors import ModelError
+    from seannet.model.config import ModelConfig
+    from seannet.training.config import TrainConfig, preset
+
+    model = build_model(
+        ModelConfig(depth=18, roi_size=4, embed_dim=64, graph_hidden=32), num_slots=M
+    )
+    first, last = model.gcn.fc[0], model.gcn.fc[2]
+    assert (first.out_features, last.in_features, last.out_features) == (32, 32, 64)
+    assert model.embed(_view_with_one_edge(0)).shape[0] == 1
+    config = preset("cpu").replace(graph_hidden=1024)
+    assert TrainConfig.from_dict(config.to_dict()).model.graph_hidden == 1024
+    assert preset("cpu").model.graph_hidden == 4096  # the paper's, by default
+    with pytest.raises(ModelError, match="graph_hidden"):
+        ModelConfig(graph_hidden=0)
