@@ -54,6 +54,8 @@ void main()
 class MergedIdPass:
     """Draws instance codes of a loaded room into the pyrender renderer's framebuffer.
 
+    Its GL objects live in the renderer's context and go with it.
+
     Args:
         renderer: pyrender's ``Renderer`` (its framebuffer, built by
             :mod:`sgdata.render.target`, is drawn into and read back).
@@ -64,6 +66,7 @@ class MergedIdPass:
     def __init__(self, renderer: Any, target: Any, platform: Any) -> None:
         self._r, self._target, self._platform = renderer, target, platform
         self._program: int | None = None
+        self._uniforms: dict[str, int] = {}  # name -> location in the program
         self._vao: int | None = None
         self._buffers: tuple[int, int] | None = None
         self._ranges: tuple[tuple[int, int, bool], ...] = ()  # (first, count, cull)
@@ -119,7 +122,7 @@ class MergedIdPass:
             GL.glUseProgram(self._program)
             eye = np.eye(4)
             for name, matrix in (("P", projection), ("V", view), ("M", eye), ("inst_m", eye)):
-                at = GL.glGetUniformLocation(self._program, name)
+                at = self._uniforms[name]
                 GL.glUniformMatrix4fv(at, 1, GL.GL_TRUE, np.asarray(matrix, np.float32))
             GL.glBindVertexArray(self._vao)
             GL.glCullFace(GL.GL_BACK)
@@ -136,21 +139,6 @@ class MergedIdPass:
         c = color.astype(np.int32)
         return c[..., 0] | (c[..., 1] << 8) | (c[..., 2] << 16)
 
-    def delete(self) -> None:
-        """Free the GL objects (the context must still be alive)."""
-        from OpenGL import GL
-
-        if self._program is None:
-            return
-        self._platform.make_current()
-        try:
-            GL.glDeleteVertexArrays(1, [self._vao])
-            GL.glDeleteBuffers(2, list(self._buffers or ()))
-            GL.glDeleteProgram(self._program)
-        finally:
-            self._platform.make_uncurrent()
-        self._program = self._vao = self._buffers = None
-
     def _upload(self, positions: np.ndarray, codes: np.ndarray) -> None:
         from OpenGL import GL
         from OpenGL.GL import shaders
@@ -161,6 +149,10 @@ class MergedIdPass:
                 shaders.compileShader(_FRAGMENT, GL.GL_FRAGMENT_SHADER),
                 validate=False,  # validation needs a bound VAO; the draw has one
             )
+            self._uniforms = {
+                name: GL.glGetUniformLocation(self._program, name)
+                for name in ("P", "V", "M", "inst_m")
+            }
             self._vao = GL.glGenVertexArrays(1)
             self._buffers = tuple(GL.glGenBuffers(2))
         GL.glBindVertexArray(self._vao)
