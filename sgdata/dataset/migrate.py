@@ -23,7 +23,6 @@ from PIL import Image
 from sgdata.dataset.manifest import FileEntry, Manifest, read_manifest, write_manifest
 from sgdata.dataset.paths import observations_path, triplets_path
 from sgdata.dataset.reader import read_table
-from sgdata.errors import DatasetError
 from sgdata.dataset.rows import PNG_STRATEGY_SINCE, encode_image, write_parquet
 from sgdata.dataset.schema import (
     FORMAT_VERSION,
@@ -31,6 +30,7 @@ from sgdata.dataset.schema import (
     observations_schema,
     triplets_schema,
 )
+from sgdata.errors import DatasetError
 
 __all__ = ["migrate_dataset"]
 

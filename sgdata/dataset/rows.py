@@ -78,9 +78,7 @@ def encode_image(rgb: np.ndarray, image_format: str = "png", *, jpeg_quality: in
     buffer = io.BytesIO()
     image = Image.fromarray(np.ascontiguousarray(rgb), mode="RGB")
     if image_format == "png":
-        image.save(
-            buffer, format="PNG", optimize=False, compress_level=6, compress_type=zlib.Z_RLE
-        )
+        image.save(buffer, format="PNG", optimize=False, compress_level=6, compress_type=zlib.Z_RLE)
     else:
         # 4:2:0 subsampling and no progressive/optimize passes: fixed, widely decodable output.
         image.save(buffer, format="JPEG", quality=int(jpeg_quality), subsampling=2, optimize=False)

@@ -106,7 +106,8 @@ def face_order(mesh: MeshData, textured: bool) -> np.ndarray:
         return np.arange(len(mesh.faces))
     which = np.asarray(mesh.face_texture)
     return np.concatenate(
-        [np.flatnonzero(which < 0)] + [np.flatnonzero(which == k) for k in range(len(mesh.textures))]
+        [np.flatnonzero(which < 0)]
+        + [np.flatnonzero(which == k) for k in range(len(mesh.textures))]
     )
 
 
@@ -128,7 +129,9 @@ def mesh_primitives(
         pick = which < 0 if k < 0 else which == k
         if pick.any():
             texture = None if k < 0 else texture_of(mesh.textures[k])
-            out.append(primitive(pr, subset(mesh, pick), double_sided=double_sided, texture=texture))
+            out.append(
+                primitive(pr, subset(mesh, pick), double_sided=double_sided, texture=texture)
+            )
     return out
 
 

@@ -52,6 +52,7 @@ import numpy as np
 
 from sgdata.errors import RenderError
 from sgdata.render.camera import CameraConfig
+from sgdata.render.id_pass import MergedIdPass
 from sgdata.render.primitives import (
     merged_world,
     mesh_primitives,
@@ -59,7 +60,6 @@ from sgdata.render.primitives import (
     same_shape,
     texture,
 )
-from sgdata.render.id_pass import MergedIdPass
 from sgdata.render.target import use_single_sample_target
 from sgdata.usd.meshes import Lighting, MeshData, SceneGeometry
 

@@ -6,8 +6,9 @@ a single-sample one and reads both back, depth converted to metres. sgdata used 
 differed between fresh processes in 2 of 7 runs), so every sample of a pixel received the same
 fragment and the resolve only averaged equal values: the four samples, the blits and the
 depth read-back were work whose result a single-sample buffer gives directly (with no sample
-buffers, GL rasterises single-sample whatever ``GL_MULTISAMPLE`` says). :func:`use_single_sample_target` replaces the two methods of one pyrender
-renderer that build and read that framebuffer; RGB and ids are the same bytes (checked on 120
+buffers, GL rasterises single-sample whatever ``GL_MULTISAMPLE`` says).
+:func:`use_single_sample_target` replaces the two methods of one pyrender renderer that build
+and read that framebuffer; RGB and ids are the same bytes (checked on 120
 generated views and in tests/sgdata/render/test_target.py), depth agrees to float32 rounding
 (it is now taken at the pixel centre, pyrender's blit took the first sample's). Depth is read
 only when :attr:`SingleSampleTarget.depth` is set: generation keeps none.
