@@ -61,6 +61,7 @@ from sgdata.render.primitives import (
     texture,
 )
 from sgdata.render.target import use_single_sample_target
+from sgdata.render.uniforms import cache_uniform_locations
 from sgdata.usd.meshes import Lighting, MeshData, SceneGeometry
 
 __all__ = ["RenderedView", "Renderer", "use_egl_platform"]
@@ -138,6 +139,7 @@ class Renderer:
             self._gl = pyrender.OffscreenRenderer(self.camera.width, self.camera.height)
             self._gl._renderer._sorted_mesh_nodes = self._draw_order
             self._target = use_single_sample_target(self._gl._renderer)
+            cache_uniform_locations(self._gl._renderer)
             self._ids = MergedIdPass(self._gl._renderer, self._target, self._gl._platform)
             Renderer._open += 1
         except Exception as exc:  # any failure here is an environment problem, not a bug

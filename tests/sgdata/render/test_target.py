@@ -1,4 +1,5 @@
-"""The single-sample framebuffer gives the pixels of pyrender's own multisampled one."""
+"""The single-sample framebuffer and the remembered uniform locations give the pixels of
+pyrender's own multisampled framebuffer and setter."""
 
 from __future__ import annotations
 
@@ -13,7 +14,8 @@ from sgdata.render.renderer import Renderer
 @pytest.fixture
 def pyrender_own(monkeypatch: pytest.MonkeyPatch, tiny_room: Any) -> Any:
     """A renderer drawing through pyrender's 4x multisampled framebuffer and blits, with
-    ``GL_MULTISAMPLE`` turned off as sgdata drew before the single-sample target."""
+    ``GL_MULTISAMPLE`` turned off as sgdata drew before the single-sample target, and
+    pyrender's own uniform setter."""
     import pyrender.renderer as pyrender_renderer
     from OpenGL.GL import GL_MULTISAMPLE, glDisable
 
@@ -26,6 +28,7 @@ def pyrender_own(monkeypatch: pytest.MonkeyPatch, tiny_room: Any) -> Any:
     renderer = Renderer()
     del renderer._gl._renderer._configure_main_framebuffer  # pyrender's methods again
     del renderer._gl._renderer._read_main_framebuffer
+    del renderer._gl._renderer._program_cache.get_program
     renderer.load(tiny_room.geometry)
     yield renderer
     renderer.close()
@@ -43,6 +46,12 @@ def test_same_pixels_and_depth_as_pyrenders_framebuffer(
         assert ours.depth is not None and np.array_equal(ours.depth > 0, theirs.depth > 0)
         assert np.allclose(ours.depth, theirs.depth, rtol=1e-5, atol=0)
         assert (ours.depth > 0).mean() > 0.9  # the walls are in view
+    remembering = [
+        "set_uniform" in vars(program)
+        for r in (tiny_renderer, pyrender_own)
+        for program in r._gl._renderer._program_cache._program_cache.values()
+    ]
+    assert remembering.count(True) >= 1 and remembering.count(False) >= 1  # ours, pyrender's
 
 
 def test_depth_is_read_only_when_asked(tiny_renderer: Renderer, tiny_view: Any) -> None:
