@@ -85,7 +85,7 @@ def _reencode_pngs(table: pa.Table, where: str) -> pa.Table:
             try:
                 with Image.open(io.BytesIO(data)) as image:
                     data = encode_image(np.asarray(image.convert("RGB")), "png")
-            except OSError as exc:
+            except (OSError, ValueError, Image.DecompressionBombError) as exc:
                 raise DatasetError(f"{where}: an image does not decode as PNG ({exc})") from None
         out.append(data)
     at = table.schema.get_field_index("image")
