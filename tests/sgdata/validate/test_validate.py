@@ -438,6 +438,22 @@ def test_a_format_2_0_0_dataset_migrates_to_the_bytes_generate_writes(
     assert {f.path: f.sha256 for f in read_manifest(copy).files} == generated
 
 
+def test_migrating_a_png_that_does_not_decode_names_the_file(copy: Path) -> None:
+    legacy_dataset(copy, version="2.0.0")
+    table = pq.read_table(copy / SHARD)
+    at = table.schema.get_field_index("image")
+    cells = table.column("image").to_pylist()
+    cells[0] = {"bytes": b"\x89PNG\r\n\x1a\n not a PNG", "path": None}
+    broken = pa.array(cells, type=table.schema.field(at).type)
+    rewrite(copy, SHARD, table.set_column(at, table.schema.field(at), broken))
+    cli = [sys.executable, "-m", "sgdata_cli.sgdata_app", "migrate", str(copy)]
+    done = subprocess.run(cli, capture_output=True, text=True, timeout=300)
+    assert done.returncode != 0
+    assert len(done.stderr.strip().splitlines()) == 1
+    assert SHARD in done.stderr and "does not decode as PNG" in done.stderr
+    assert read_manifest(copy).format_version == "2.0.0"  # the manifest is written last
+
+
 def test_card_and_croissant_that_disagree_are_reported(copy: Path) -> None:
     card = copy / "README.md"
     text = card.read_text()
