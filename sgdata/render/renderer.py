@@ -394,9 +394,7 @@ class Renderer:
 
     def _raster_index(self, x: float, y: float, theta: float) -> np.ndarray:
         pose = self.camera.pose_matrix(x, y, theta)
-        self._scene.set_pose(self._cam_node, pose)
-        camera = self._scene.main_camera_node.camera
-        projection = camera.get_projection_matrix(
+        projection = self._cam_node.camera.get_projection_matrix(
             width=self.camera.width, height=self.camera.height
         )
         code = self._ids.draw(np.linalg.inv(pose), projection)  # V and P as pyrender's
