@@ -29,7 +29,9 @@ class ViewAnnotator:
         slots: the class slot runs.
         min_visible_pixels: fewer visible pixels and an object is not in the view.
         rules: relation rules.
-        keep_depth: keep the depth image in the records.
+        keep_depth: keep the depth image in the records (metres along the view axis).
+        keep_instances: keep the instance mask in the records
+            (:meth:`~sgdata.annotate.boxes.Annotation.instance_mask`).
     """
 
     def __init__(
@@ -40,12 +42,14 @@ class ViewAnnotator:
         min_visible_pixels: int = 20,
         rules: RelationRules | None = None,
         keep_depth: bool = False,
+        keep_instances: bool = False,
     ) -> None:
         self.renderer = renderer
         self.slots = slots
         self.min_visible_pixels = int(min_visible_pixels)
         self.rules = rules or RelationRules()
         self.keep_depth = keep_depth
+        self.keep_instances = keep_instances
         self._room: Room | None = None
         self._layout = -1
         self._table: ObjectTable | None = None
@@ -128,4 +132,5 @@ class ViewAnnotator:
             light_intensity=self._lighting.intensity,
             light_temperature=self._lighting.temperature,
             depth=rendered.depth if self.keep_depth else None,
+            instances=ann.instance_mask(keep) if self.keep_instances else None,
         )

@@ -103,9 +103,29 @@ class Annotation:
     instance: np.ndarray  # (k,) int64
     box2d: np.ndarray  # (k, 4) int32 [u1, v1, u2, v2], u2/v2 exclusive
     visible_pixels: np.ndarray  # (k,) int64
+    # (H, W) int64 per pixel: 0 background or structure, else the ObjectTable row + 1 of the
+    # object seen there (visible or not): the mask channels are drawn from it
+    label: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.rows)
+
+    def instance_mask(self, keep: np.ndarray | None = None) -> np.ndarray:
+        """(H, W) uint16 mask: 0 background, ``k`` where the k-th listed object is seen
+        (1-based, in ``rows`` order, after ``keep`` selects the rows that are kept); pixels
+        of objects not listed are 0.
+
+        Raises:
+            RenderError: the annotation holds no label image, or more than 65,535 objects.
+        """
+        if self.label is None:
+            raise RenderError("this annotation kept no label image: annotate() sets it")
+        rows = self.rows if keep is None else self.rows[keep]
+        if len(rows) > np.iinfo(np.uint16).max:
+            raise RenderError(f"{len(rows)} visible objects: a uint16 mask holds at most 65535")
+        lut = np.zeros(int(self.label.max(initial=0)) + 1, dtype=np.uint16)
+        lut[rows + 1] = np.arange(1, len(rows) + 1, dtype=np.uint16)
+        return lut[self.label]
 
 
 def annotate(view: RenderedView, table: ObjectTable, *, min_visible_pixels: int = 20) -> Annotation:
@@ -151,6 +171,7 @@ def annotate(view: RenderedView, table: ObjectTable, *, min_visible_pixels: int 
         instance=inst[visible],
         box2d=box.reshape(-1, 4),
         visible_pixels=counts[lab].astype(np.int64),
+        label=label.reshape(h, w),
     )
 
 

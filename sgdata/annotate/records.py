@@ -69,6 +69,8 @@ class ViewRecord:
     light_intensity: float | None = None  # scale of the default lights (the stage's light)
     light_temperature: float | None = None  # Kelvin; None: the default white light
     depth: np.ndarray | None = field(default=None, repr=False)  # (H, W) float32 if kept
+    # (H, W) uint16 if kept: 0 background, k where the k-th object of the obj_* columns is seen
+    instances: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def num_objects(self) -> int:

@@ -93,3 +93,28 @@ def test_overlay_draws(record: ViewRecord) -> None:
     assert img.size == (672, 672 + 22)
     px = np.asarray(img)
     assert (px[:672] != np.repeat(np.repeat(record.rgb, 3, axis=0), 3, axis=1)).any()
+
+
+def test_depth_and_instance_channels(tiny_renderer: Any, tiny_room: Any, tiny_view: Any) -> None:
+    """The instance mask numbers the listed objects 1..k: each one's extent is its stored box
+    and its pixel count its visible pixels; a dropped object (chair_b) leaves no pixel; depth
+    is metric and hits wherever an object is seen."""
+    va = ViewAnnotator(tiny_renderer, SLOTS, keep_depth=True, keep_instances=True)
+    va.set_layout(tiny_room.room, tiny_room.geometry, 0)
+    rec = va.view(ViewPose(*tiny_view, grid_i=10, grid_j=2, heading=1), seed=5)
+    mask, depth = rec.instances, rec.depth
+    assert mask is not None and depth is not None
+    assert mask.dtype == np.uint16 and mask.shape == rec.rgb.shape[:2]
+    assert int(mask.max()) == rec.num_objects
+    for k in range(rec.num_objects):
+        v, u = np.nonzero(mask == k + 1)
+        assert [u.min(), v.min(), u.max() + 1, v.max() + 1] == rec.obj_box2d[k].tolist()
+        assert len(u) == rec.obj_visible_pixels[k]
+    ids = tiny_renderer.render_ids(*tiny_view)
+    assert not mask[ids == tiny_room.ids["chair_b"]].any()
+    assert (depth[mask > 0] > 0).all() and float(depth.max()) < np.hypot(5.0, 4.0)
+    plain = ViewAnnotator(tiny_renderer, SLOTS)
+    plain.set_layout(tiny_room.room, tiny_room.geometry, 0)
+    again = plain.view(ViewPose(*tiny_view, grid_i=10, grid_j=2, heading=1), seed=5)
+    assert again.instances is None and again.depth is None
+    assert np.array_equal(again.rgb, rec.rgb)  # reading depth back leaves the pixels as they are
