@@ -46,11 +46,12 @@ from results import provenance  # noqa: E402  (bench/results.py: one home for pr
 import seannet  # noqa: E402,F401  (imports torch's compiler stack first: see tests/conftest.py)
 from seannet.data.datasets import dataset_identity  # noqa: E402
 from seannet.data.live_views import LiveRooms  # noqa: E402
+from seannet.navigation.benchmark import run_labels, run_navigation  # noqa: E402
 from seannet.navigation.episodes import CASES  # noqa: E402
 from seannet.navigation.localizer import run_epsilon  # noqa: E402
 from seannet.navigation.maps import MAP_META, derive_map, load_map, save_map  # noqa: E402
-from seannet.navigation.navigate import run_labels, run_navigation  # noqa: E402
 from seannet.navigation.navigator import NavigatorConfig  # noqa: E402
+from seannet.navigation.navigator_training import fit_navigator, train_navigator  # noqa: E402
 from seannet.navigation.pairs import PairSet, render_pairs  # noqa: E402
 from seannet.navigation.tables import (  # noqa: E402
     RATE_HEADER,
@@ -60,7 +61,6 @@ from seannet.navigation.tables import (  # noqa: E402
     read_results,
     time_rows,
 )
-from seannet.navigation.train_navigator import fit_navigator, train_navigator  # noqa: E402
 from seannet.training.runs import BEST, HISTORY, load_checkpoint  # noqa: E402
 from seannet.weights import LITE0_WEIGHTS  # noqa: E402
 from sgdata.dataset import Dataset  # noqa: E402

@@ -46,8 +46,8 @@ from seannet.data.box_noise import BoxNoise  # noqa: E402
 from seannet.data.datasets import open_dataset  # noqa: E402
 from seannet.evaluation.compare import compare_models  # noqa: E402
 from seannet.evaluation.eval import eval_file, evaluate_run, scene_term  # noqa: E402
-from seannet.navigation.localize import run_localize  # noqa: E402
 from seannet.navigation.localizer import load_localizer  # noqa: E402
+from seannet.navigation.map_localization import run_localize  # noqa: E402
 from seannet.navigation.maps import build_maps  # noqa: E402
 from sgdata.dataset.rows import sha256_file  # noqa: E402
 from sgdata.fileio import atomic_write_text  # noqa: E402

@@ -255,7 +255,7 @@ def localize(
     out: Annotated[Path | None, typer.Option(help="Where to write (default: the run).")] = None,
 ) -> None:
     """Best-matching map sub-nodes of queries, or recall@1/@5 on a split (other layouts)."""
-    from seannet.navigation.localize import run_localize
+    from seannet.navigation.map_localization import run_localize
 
     result = run_localize(
         run, map_path, data, queries=queries or None, split=split, epsilon=epsilon, out=out
@@ -294,7 +294,7 @@ def train_navigator_command(
     from rich.progress import Progress
 
     from seannet.navigation.navigator import NavigatorConfig
-    from seannet.navigation.train_navigator import train_navigator
+    from seannet.navigation.navigator_training import train_navigator
 
     config = NavigatorConfig(
         encoder=encoder, image_size=image_size, epochs=epochs, batch_size=batch_size,
@@ -354,7 +354,7 @@ def navigate(
     """The navigation test (paper Table II): success and failure rates, N / A, per localizer.
     Resumes where a killed run stopped."""
     from seannet.errors import NavigationError
-    from seannet.navigation.navigate import run_navigation
+    from seannet.navigation.benchmark import run_navigation
     from seannet.navigation.tables import RATE_HEADER, rate_rows
 
     if (navigator is None) == (not oracle):

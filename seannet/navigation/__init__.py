@@ -10,7 +10,7 @@ _EXPORTS = {
     "build_maps": ".maps",
     "NavigatorConfig": ".navigator",
     "load_navigator": ".navigator",
-    "train_navigator": ".train_navigator",
+    "train_navigator": ".navigator_training",
 }
 
 __all__ = sorted(_EXPORTS)

@@ -3,7 +3,7 @@
 The network and what it learns from: its config, the label rule and the draw of a training
 pair (the authors: goal within +-2 cells sideways and 0..4 cells forward of the current pose,
 same heading; the label is the larger displacement). Rendering pairs is in
-:mod:`seannet.navigation.pairs`, training in :mod:`seannet.navigation.train_navigator`;
+:mod:`seannet.navigation.pairs`, training in :mod:`seannet.navigation.navigator_training`;
 :class:`Policy` acts with a trained one.
 """
 

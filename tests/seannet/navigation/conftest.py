@@ -7,9 +7,9 @@ from types import SimpleNamespace
 
 import pytest
 
-from seannet.navigation.navigate import run_navigation
+from seannet.navigation.benchmark import run_navigation
 from seannet.navigation.navigator import NavigatorConfig
-from seannet.navigation.train_navigator import train_navigator
+from seannet.navigation.navigator_training import train_navigator
 
 # What the tiny navigation run used: the kill-and-resume test runs it again with these.
 TINY_NAVIGATION = {"episodes": 2, "epsilon": 0.95, "replan": True}

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from seannet.errors import MapError, NavigationError
-from seannet.navigation.localize import moved_bin, run_localize
 from seannet.navigation.localizer import load_localizer, run_epsilon
+from seannet.navigation.map_localization import moved_bin, run_localize
 from seannet.navigation.maps import (
     MAP_META,
     TopoMap,

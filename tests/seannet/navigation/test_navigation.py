@@ -17,6 +17,7 @@ import torch
 
 from seannet.data.live_views import LiveRooms
 from seannet.errors import ModelError, NavigationError
+from seannet.navigation.benchmark import run_navigation
 from seannet.navigation.episodes import (
     OUTCOMES,
     Step,
@@ -28,7 +29,6 @@ from seannet.navigation.episodes import (
 )
 from seannet.navigation.maps import load_map
 from seannet.navigation.motion import apply, local_offset, turn_towards
-from seannet.navigation.navigate import run_navigation
 from seannet.navigation.navigator import (
     NavigatorConfig,
     VisualNavigator,

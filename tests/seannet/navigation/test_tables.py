@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from seannet.errors import NavigationError
-from seannet.navigation.navigate import run_labels
+from seannet.navigation.benchmark import run_labels
 from seannet.navigation.tables import case_rates, markdown, wilson
 
 

@@ -16,8 +16,8 @@ from seannet.navigation.navigator import (
     load_navigator,
     navigator_inputs,
 )
+from seannet.navigation.navigator_training import jitter, pair_accuracy, train_navigator
 from seannet.navigation.pairs import render_pairs
-from seannet.navigation.train_navigator import jitter, pair_accuracy, train_navigator
 from seannet.training.runs import load_checkpoint
 
 CONFIG = NavigatorConfig(

@@ -1,0 +1,303 @@
+"""``seannet navigate``: the navigation benchmark (paper Table II) of localizer runs.
+
+Every localizer run is tested on the same episodes: each is drawn from
+:func:`sgdata.seeds.episode_seed` (test seed, room, case, index) and from the map's structure,
+which is the same whatever run embedded it. Maps are built once per run and room into
+``<maps>/<run label>/<room>/`` and reused (:func:`seannet.navigation.maps.ensure_map`).
+
+A run's label is the shortest tail of its path that tells it from the other runs
+(``seed0``, or ``lr0.01_seed0`` next to ``lr0.003_seed0``).
+
+The work runs in spawned worker processes that die with their parent
+(:func:`sgdata.pipeline.executors.run_tasks`), one task per map, then one per (run, room,
+case), whatever ``workers`` is: every view is rasterised by a single-threaded llvmpipe and
+every network runs on one thread, so the results do not depend on the worker count. Each task
+writes its episodes atomically to ``<out>/parts/<run label>/<room>_<case>.json`` with the key
+of everything they depend on; a run that was killed starts again where it stopped, and a part
+whose key differs is run again. Wall times are the one thing that varies: they are written
+to ``navigate_<split>_times.json``, beside ``navigate_<split>.json``, which holds the same
+bytes for the same settings whatever the worker count or the interruptions.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from PIL import Image, ImageDraw, ImageFont
+
+from seannet.data.datasets import dataset_identity, open_dataset
+from seannet.data.live_views import LiveRooms
+from seannet.errors import NavigationError
+from seannet.model.pretrained import file_sha256
+from seannet.navigation.episodes import CASES, K_MAX, EpisodeResult, run_episode, sample_episode
+from seannet.navigation.localizer import Localizer, load_localizer
+from seannet.navigation.maps import check_map, current_map, ensure_map, load_map
+from seannet.navigation.navigator import load_navigator, resize
+from seannet.navigation.tables import markdown, write_results
+from seannet.training.runs import BEST, check_same_dataset, load_checkpoint
+from sgdata.fileio import atomic_write_text, save_png
+from sgdata.pipeline.executors import run_tasks
+from sgdata.seeds import episode_seed, rng_for
+
+__all__ = ["ORACLE", "draw_strip", "run_labels", "run_navigation"]
+
+ORACLE = "oracle"  # the navigator that takes the right action from the true pose
+STRIP_PANEL = 112  # pixels
+STRIP_MAX_PANELS = 16
+PARTS = "parts"
+
+
+def run_navigation(
+    runs: list[Path],
+    navigator: Path | None,
+    data: Path,
+    *,
+    split: str = "test",
+    episodes: int = 20,
+    seed: int = 0,
+    k_max: int = K_MAX,
+    spacing: int = 2,
+    epsilon: float | dict[Path, tuple[float, str]] | None = None,
+    replan: bool = False,
+    workers: int = 1,
+    out: Path | None = None,
+    maps: Path | None = None,
+    strips: Path | None = None,
+    progress: Callable[[str], None] | None = None,
+) -> dict[str, Any]:
+    """Run the navigation test of every localizer run on the rooms of ``split``.
+
+    Args:
+        navigator: a ``train-navigator`` run; None for the oracle (:data:`ORACLE`).
+        replan: run every episode under bump and replan; its paper-rule outcome is read off
+            the same run (see :mod:`seannet.navigation.episodes`).
+        workers: processes running maps and episodes in parallel.
+        epsilon: one threshold for every run, or per run ``(epsilon, where it comes from)``
+            (a run left out reads its eval files); None: each run's eval files.
+
+    Writes ``navigate_<split>.json`` and ``.md`` into ``out`` (default: the navigator run),
+    maps under ``maps`` (default: ``out/maps``), and under ``strips`` when given, per run,
+    room and case, the first episode of each outcome (and cause or kind) as a strip.
+
+    Raises:
+        CheckpointError: a run or the navigator was trained on another dataset.
+        NavigationError: bad counts, no epsilon for a run, a split without rooms, a room
+            without an episode, or no ``out`` for the oracle.
+    """
+    if episodes < 1:
+        raise NavigationError(f"--episodes {episodes}: expected >= 1 per case and room")
+    if workers < 1:
+        raise NavigationError(f"--workers {workers}: expected >= 1")
+    out = out if out is not None else navigator
+    if out is None:
+        raise NavigationError("the oracle navigator has no run directory: pass --out")
+    maps = maps or out / "maps"
+    identity = dataset_identity(data)
+    if navigator is not None:
+        state = load_checkpoint(navigator / BEST)
+        check_same_dataset(navigator / BEST, state["dataset"], identity)
+        load_navigator(navigator)  # refuses a localizer run given as the navigator, here
+    ds = open_dataset(data)
+    rooms = list(ds.rooms(split)) if split in ds.splits else []
+    if not rooms:
+        raise NavigationError(f"{data}: split {split!r} has no room to navigate in")
+    say = progress or (lambda _: None)
+    localizers = [_localizer(run, data, epsilon) for run in runs]
+    settings = {
+        "split": split,
+        "episodes_per_case_and_room": episodes,
+        "seed": seed,
+        "k_max": k_max,
+        "spacing": spacing,
+        "replan": replan,
+        "navigator": str(navigator) if navigator is not None else ORACLE,
+        "navigator_sha256": file_sha256(navigator / BEST) if navigator is not None else ORACLE,
+        "dataset": identity,
+    }
+    labels = dict(zip(runs, run_labels(runs), strict=True))
+    map_jobs = [
+        (loc.run, data, room_id, maps / labels[loc.run] / room_id, spacing)
+        for loc in localizers
+        for room_id in rooms
+        if current_map(loc, room_id, maps / labels[loc.run] / room_id, spacing=spacing) is None
+    ]
+    for done in run_tasks(_map_task, map_jobs, workers=workers):
+        say(f"map of {done['room_id']} by {done['run']}")
+    jobs = {
+        (loc.run, room_id, case): {
+            **settings,
+            "run": str(loc.run),
+            "checkpoint_sha256": loc.digest,
+            "epsilon": loc.epsilon,
+            "room_id": room_id,
+            "case": case,
+            "label": labels[loc.run],
+            "map": str(maps / labels[loc.run] / room_id),
+            "strips": str(strips / labels[loc.run]) if strips is not None else None,
+        }
+        for loc in localizers
+        for room_id in rooms
+        for case in CASES
+    }
+    todo = [(job, str(data), str(out)) for job in jobs.values() if _part(job, out) is None]
+    for done in run_tasks(_case_task, todo, workers=workers):
+        say(f"{done['label']}: {done['room_id']} {done['case']} done")
+    results: dict[str, Any] = {**settings, "runs": []}
+    for loc in localizers:
+        records = []
+        for room_id in rooms:
+            for case in CASES:
+                part = _part(jobs[loc.run, room_id, case], out)
+                if part is None:
+                    path = _part_path(jobs[loc.run, room_id, case], out)
+                    raise NavigationError(f"{path}: missing after its task ran")
+                records += part
+        results["runs"].append(
+            {
+                "run": str(loc.run),
+                "label": labels[loc.run],
+                "model": loc.name,
+                "epsilon": loc.epsilon,
+                "epsilon_source": loc.epsilon_source,
+                "checkpoint_sha256": loc.digest,
+                "episodes": records,
+            }
+        )
+    out.mkdir(parents=True, exist_ok=True)
+    write_results(results, out / f"navigate_{split}.json")
+    atomic_write_text(out / f"navigate_{split}.md", markdown(results))
+    results["written"] = str(out / f"navigate_{split}.md")
+    return results
+
+
+def _localizer(
+    run: Path, data: Path, epsilon: float | dict[Path, tuple[float, str]] | None
+) -> Localizer:
+    if isinstance(epsilon, dict):
+        given, source = epsilon.get(run, (None, ""))
+        return load_localizer(run, data, epsilon=given, source=source)
+    return load_localizer(run, data, epsilon=epsilon)
+
+
+def run_labels(runs: list[Path]) -> list[str]:
+    """The shortest tails of the runs' paths (parts joined by ``_``) that are all different.
+
+    Raises:
+        NavigationError: a run given twice.
+    """
+    paths = [run.resolve() for run in runs]
+    if len(set(paths)) < len(paths):
+        raise NavigationError("a localizer run is given twice; give each once")
+    for k in range(1, max(len(p.parts) for p in paths) + 1):
+        labels = ["_".join(p.parts[-k:]).lstrip("/_") for p in paths]
+        if len(set(labels)) == len(labels):
+            return labels
+    raise NavigationError("localizer runs cannot be told apart by their paths")  # unreachable
+
+
+# What a part depends on: the test's settings, the run and its threshold, the room and case.
+_KEY_FIELDS = (
+    "split", "episodes_per_case_and_room", "seed", "k_max", "spacing", "replan",
+    "navigator_sha256", "dataset", "run", "checkpoint_sha256", "epsilon", "room_id", "case",
+)  # fmt: skip
+
+
+def _key(job: dict[str, Any]) -> dict[str, Any]:
+    return {k: job[k] for k in _KEY_FIELDS}
+
+
+def _part_path(job: dict[str, Any], out: Path) -> Path:
+    return out / PARTS / job["label"] / f"{job['room_id']}_{job['case']}.json"
+
+
+def _part(job: dict[str, Any], out: Path) -> list[dict[str, Any]] | None:
+    """The episodes of a finished task whose key matches ``job``'s, else None."""
+    path = _part_path(job, out)
+    try:
+        part = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+    if not isinstance(part, dict) or part.get("key") != json.loads(json.dumps(_key(job))):
+        return None
+    return part.get("episodes")
+
+
+def _one_thread() -> None:
+    """Every network of a task on one thread: results then do not depend on the machine."""
+    import torch
+
+    torch.set_num_threads(1)
+
+
+def _map_task(run: Path, data: Path, room_id: str, directory: Path, spacing: int) -> dict:
+    """Build (or reuse) one room's map by one run (in a worker)."""
+    _one_thread()
+    localizer = load_localizer(run, data, require_epsilon=False)
+    with LiveRooms(data) as live:
+        ensure_map(localizer, live, room_id, directory, spacing=spacing)
+    return {"run": str(run), "room_id": room_id}
+
+
+def _case_task(job: dict[str, Any], data: str, out: str) -> dict:
+    """Every episode of one (run, room, case), written as one part file (in a worker)."""
+    _one_thread()
+    localizer: Localizer = load_localizer(Path(job["run"]), Path(data), epsilon=job["epsilon"])
+    navigator = job["navigator"]
+    policy = None if navigator == ORACLE else load_navigator(Path(navigator))
+    directory = Path(job["map"])
+    topo = load_map(directory)
+    check_map(topo, localizer, directory)
+    room_id, case = job["room_id"], job["case"]
+    records = []
+    drawn: set[str] = set()  # the outcome kinds drawn as strips already
+    with LiveRooms(Path(data)) as live:
+        for index in range(job["episodes_per_case_and_room"]):
+            rng = rng_for(episode_seed(job["seed"], room_id, case, index))
+            episode = sample_episode(topo, live, case, rng, index=index)
+            keep = job["strips"] is not None
+            started = time.perf_counter()
+            result = run_episode(
+                episode, topo, live, localizer, policy,
+                k_max=job["k_max"], replan=job["replan"], keep_frames=keep,
+            )  # fmt: skip
+            record = result.to_dict()
+            record["seconds"]["total"] = time.perf_counter() - started
+            records.append(record)
+            kind = "_".join(str(k).replace(" ", "-") for k in (result.outcome, result.detail) if k)
+            if keep and kind not in drawn:  # the first episode of each kind (the paper's Fig. 9)
+                drawn.add(kind)
+                strip = draw_strip(result, topo.image(episode.path[-1]))
+                save_png(strip, Path(job["strips"]) / f"{room_id}_{case}_{index}_{kind}.png")
+    path = _part_path(job, Path(out))
+    atomic_write_text(path, json.dumps({"key": _key(job), "episodes": records}))
+    return {"label": job["label"], "room_id": room_id, "case": case}
+
+
+def draw_strip(result: EpisodeResult, goal: np.ndarray) -> Image.Image:
+    """An episode as a strip (the paper's Fig. 9): start, each step's view with its action
+    and S, then the goal view; the outcome in the title."""
+    e = result.episode
+    labels = ["start"]
+    for _, steps in result.segments:
+        labels += [f"{s.action} S={s.similarity:.2f}" for s in steps if not s.collided]
+    frames = list(zip(result.frames, labels, strict=False))[: STRIP_MAX_PANELS - 1]
+    frames.append((goal, "goal"))
+    size, top = STRIP_PANEL, 34
+    image = Image.new("RGB", (len(frames) * (size + 4) + 4, size + top + 18), "white")
+    draw = ImageDraw.Draw(image)
+    font = ImageFont.load_default(size=11)
+    title = (
+        f"{e.room_id} layout {e.layout} case {e.case} #{e.index}: {result.outcome} "
+        f"({len(e.path) - 1} segments)"
+    )
+    draw.text((4, 4), title, fill="black", font=font)
+    for k, (rgb, label) in enumerate(frames):
+        x = 4 + k * (size + 4)
+        image.paste(Image.fromarray(resize(rgb, size)), (x, top))
+        draw.text((x, top + size + 3), label, fill="black", font=font)
+    return image
