@@ -24,6 +24,7 @@ import pyarrow.parquet as pq
 from PIL import Image
 
 from sgdata.annotate.records import ViewRecord
+from sgdata.dataset.channels import encode_depth, encode_mask
 from sgdata.dataset.paths import SCENE_LAYER, obs_id
 from sgdata.dataset.schema import observations_schema, triplets_schema
 from sgdata.dataset.storage import file_table
@@ -106,11 +107,13 @@ def _check_record(rec: ViewRecord) -> int:
         )
     if not len(rec.rel_src) == len(rec.rel_dst) == len(rec.rel_type):
         raise DatasetError(f"view {rec.room_id}: rel_src, rel_dst, rel_type lengths differ")
-    if rec.rgb.shape[:2] != (rec.image_height, rec.image_width):
-        raise DatasetError(
-            f"view {rec.room_id}: rgb is {rec.rgb.shape[:2]} but the camera says "
-            f"{rec.image_height} x {rec.image_width}"
-        )
+    for name in ("rgb", "depth", "instances"):
+        image = getattr(rec, name)
+        if image is not None and image.shape[:2] != (rec.image_height, rec.image_width):
+            raise DatasetError(
+                f"view {rec.room_id}: {name} is {image.shape[:2]} but the camera says "
+                f"{rec.image_height} x {rec.image_width}"
+            )
     return k
 
 
@@ -250,6 +253,13 @@ def observation_table(
         "textures": pa.array([r.textures for r in records], type=pa.bool_()),
         "light_intensity": pa.array([r.light_intensity for r in records], type=pa.float32()),
         "light_temperature": pa.array([r.light_temperature for r in records], type=pa.float32()),
+        "depth": pa.array(
+            [None if r.depth is None else encode_depth(r.depth) for r in records], pa.binary()
+        ),
+        "instances": pa.array(
+            [None if r.instances is None else encode_mask(r.instances) for r in records],
+            pa.binary(),
+        ),
     }
     return pa.Table.from_arrays([columns[f.name] for f in schema], schema=schema)
 

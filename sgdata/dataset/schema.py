@@ -64,10 +64,11 @@ __all__ = [
     "since",
 ]
 
-FORMAT_VERSION = "2.0.1"  # semver of the whole on-disk format: tables + dataset.json
+FORMAT_VERSION = "2.1.0"  # semver of the whole on-disk format: tables + dataset.json
 # 1.1.0 added the observation columns textures, light_intensity and light_temperature; 2.0.0
 # stores `image` as the Hugging Face Image struct and adds README.md and croissant.json; 2.0.1
 # deflates PNGs with zlib's RLE strategy (same pixels, other bytes; readers change nothing).
+# 2.1.0 adds the optional per-view channels depth and instances (nullable image columns).
 # The oldest format this sgdata reads: 1.x differs from 2.x only in how images are stored
 # (sgdata.dataset.storage reads both) and in lacking the card and Croissant files.
 OLDEST_READABLE = "1.0.0"

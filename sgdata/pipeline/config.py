@@ -41,6 +41,7 @@ __all__ = [
     "GenerateConfig",
     "ImagesConfig",
     "LayoutsConfig",
+    "OutputsConfig",
     "PosesConfig",
     "INTERNAL",
     "SPARSE",
@@ -238,6 +239,15 @@ class ImagesConfig:
 
 
 @dataclass(frozen=True)
+class OutputsConfig:
+    """Which per-view channels the observation rows carry besides the RGB
+    (:mod:`sgdata.dataset.channels`); each costs its encoding and bytes, not another render."""
+
+    depth: bool = False  # metric depth, uint16 millimetres along the view axis, 0 = no hit
+    instances: bool = False  # instance mask, uint16: 0 background, k = the k-th listed object
+
+
+@dataclass(frozen=True)
 class GenerateConfig:
     """Everything ``sgdata generate`` needs; the resolved form goes into the manifest."""
 
@@ -251,6 +261,7 @@ class GenerateConfig:
     triplets: TripletsConfig = field(default_factory=TripletsConfig)
     images: ImagesConfig = field(default_factory=ImagesConfig)
     appearance: AppearanceConfig = field(default_factory=AppearanceConfig)  # [appearance]
+    outputs: OutputsConfig = field(default_factory=OutputsConfig)  # [outputs]: extra channels
 
 
 def load_config(source: str | Path) -> GenerateConfig:

@@ -141,7 +141,12 @@ def render_room_views(
 def _annotator(config: GenerateConfig) -> tuple[Any, dict[str, int]]:
     """This worker's view annotator, built once (its renderer stays alive)."""
     key = json.dumps(
-        [config.camera.__dict__, config.annotation.min_visible_pixels, config.appearance.textures],
+        [
+            config.camera.__dict__,
+            config.annotation.min_visible_pixels,
+            config.appearance.textures,
+            config.outputs.__dict__,
+        ],
         sort_keys=True,
     )
     if _worker.get("key") != key:
@@ -161,6 +166,8 @@ def _annotator(config: GenerateConfig) -> tuple[Any, dict[str, int]]:
                 slots,
                 min_visible_pixels=config.annotation.min_visible_pixels,
                 rules=config.annotation.relations,
+                keep_depth=config.outputs.depth,
+                keep_instances=config.outputs.instances,
             ),
             class_ids={c.name: c.id for c in classes},
         )
