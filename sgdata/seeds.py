@@ -6,7 +6,7 @@ same stream by accident and a path never changes without this file changing::
     dataset seed ─┬─ room_seed(type index, room index) ─┬─ layouts_seed(request) ─ layout_seed(k)
                   │                                     ├─ view_seed(layout, i, j, heading)
                   │                                     └─ room_look_seed()  (base looks)
-                  ├─ own_room_seed(room id)  (a user's room of [rooms] files; then as above)
+                  ├─ user_room_seed(room id)  (a user's room of [rooms] files; then as above)
                   └─ split_triplets_seed(split) ─ triplet_stream_seed(split, room, tier)
     training seed ─ init_seed() / epoch_order_seed(epoch) / epoch_dropout_seed(epoch)
     navigator seed ─ navigator_init_seed() / navigator_pairs_seed(split, room)
@@ -23,12 +23,14 @@ import hashlib
 
 import numpy as np
 
+from sgdata.deprecation import moved_names
+
 __all__ = [
     "derive_seed",
     "rng_for",
     "name_key",
     "room_seed",
-    "own_room_seed",
+    "user_room_seed",
     "layouts_seed",
     "layout_seed",
     "view_seed",
@@ -57,7 +59,9 @@ _BOX_NOISE = "box noise"  # the purpose key of evaluation's labeler / detector n
 _LOOKS = "looks"  # the purpose key of a room's base looks (texture variants)
 _APPEARANCE = "appearance"  # the purpose key of a layout's appearance draw
 _TEXTURES = "textures"  # the root key of procedural texture images
-_OWN_ROOMS = "own rooms"  # the purpose key of the rooms users bring ([rooms] files)
+# the purpose key of the rooms users bring ([rooms] files); the string predates the "user"
+# naming and stays: changing it would move every user room's draws
+_USER_ROOMS = "own rooms"
 
 
 def derive_seed(parent: int, *keys: int) -> int:
@@ -86,10 +90,10 @@ def room_seed(dataset_seed: int, type_index: int, index: int) -> int:
     return derive_seed(dataset_seed, type_index, index)
 
 
-def own_room_seed(dataset_seed: int, room_id: str) -> int:
+def user_room_seed(dataset_seed: int, room_id: str) -> int:
     """A user room's seed (its layouts and views derive from it), by its room id: adding or
     reordering ``[rooms] files`` entries moves no other room's draws."""
-    return derive_seed(dataset_seed, name_key(_OWN_ROOMS), name_key(room_id))
+    return derive_seed(dataset_seed, name_key(_USER_ROOMS), name_key(room_id))
 
 
 def layouts_seed(room: int, request: int) -> int:
@@ -180,3 +184,7 @@ def texture_seed(kind: str, variant: int) -> int:
     """One procedural texture image, by its kind and variant only: every room and dataset
     shares the same images."""
     return derive_seed(name_key(_TEXTURES), name_key(kind), variant)
+
+
+# old names, served with a DeprecationWarning for one release
+__getattr__ = moved_names(__name__, {"own_room_seed": "sgdata.seeds:user_room_seed"})

@@ -3,7 +3,7 @@
 :func:`resolve_user_rooms` runs in the main process before the output directory is touched: every
 listed file must exist and be a USD stage with at least one ``sgdata:class`` prim, every class
 must be a catalog class or an alias of one in the ``[rooms] classes`` file, and the room must be
-measurable (:func:`sgdata.usd.own_rooms.measure_stage`). It fills in what the config left open
+measurable (:func:`sgdata.usd.user_rooms.measure_stage`). It fills in what the config left open
 (each file's SHA-256 and room type), so the resolved config in the ledger and the manifest
 records exactly which bytes the dataset was made from.
 
@@ -23,7 +23,7 @@ from sgdata.dataset.rows import sha256_file
 from sgdata.errors import ConfigError, SgdataError, UsdError
 from sgdata.pipeline.config import ROOM_TYPE_NAME, GenerateConfig, RoomFile, RoomsConfig
 from sgdata.scene_files import SOURCE_FILE, room_file
-from sgdata.seeds import own_room_seed
+from sgdata.seeds import user_room_seed
 from sgdata.world.catalog import Catalog, load_catalog
 from sgdata.world.scene import Room
 from sgdata.world.user_classes import UserClasses, read_class_file
@@ -106,7 +106,7 @@ def copy_user_room(entry: RoomFile, config: GenerateConfig, room_dir: Path) -> R
         )
     source = room_dir / SOURCE_FILE
     write_flattened(path, source, doc=f"sgdata: {entry.path} flattened (sha256 {entry.sha256})")
-    names = RoomNames(entry.id, entry.type, own_room_seed(config.dataset.seed, entry.id))
+    names = RoomNames(entry.id, entry.type, user_room_seed(config.dataset.seed, entry.id))
     report = tag_stage(
         source,
         classes=rooms.resolve(rooms.classes) if rooms.classes else None,
@@ -130,9 +130,9 @@ def _inspect(path: Path, classes: UserClasses, catalog: Catalog, rooms: RoomsCon
     """The room of a user's file, measured; every class a catalog class or an alias of one, and
     every size one a home holds."""
     from sgdata.usd.object_prims import object_prims
-    from sgdata.usd.own_rooms import measure_stage
     from sgdata.usd.room_sizes import check_sizes
     from sgdata.usd.stage import open_stage
+    from sgdata.usd.user_rooms import measure_stage
 
     stage = open_stage(path)
     prims = [p for p in object_prims(stage) if p.HasAttribute("sgdata:class")]

@@ -26,9 +26,9 @@ from pxr import Gf, Sdf, UsdGeom, Vt
 from sgdata.errors import SceneError, UsdError
 from sgdata.scene_files import ROOM_FILE
 from sgdata.usd.looks import RoomParts, define_layout_materials, override_light, override_look
-from sgdata.usd.own_layouts import OwnFrame, override_own
 from sgdata.usd.prims import ROOT, object_path
 from sgdata.usd.stage import open_layer, write_text_atomic
+from sgdata.usd.user_layouts import UserFrame, override_user
 from sgdata.world.appearance import LayoutAppearance
 from sgdata.world.scene import Room, SceneObject
 
@@ -47,7 +47,7 @@ def write_layout(
     index: int,
     seed: int,
     moves: list[dict],
-    own: OwnFrame | None = None,
+    user: UserFrame | None = None,
     appearance: LayoutAppearance | None = None,
     parts: RoomParts | None = None,
 ) -> None:
@@ -60,7 +60,7 @@ def write_layout(
         index: the layout index k, stored as provenance.
         seed: the seed the layout was sampled from, stored as provenance.
         moves: one record per object move (JSON-able values), stored as provenance.
-        own: for a room authored elsewhere (:func:`sgdata.usd.own_layouts.own_frame`): its
+        user: for a room authored elsewhere (:func:`sgdata.usd.user_layouts.user_frame`): its
             prim paths and frame; moves are then written as each prim's local matrix.
         appearance: the layout's light and object looks (:func:`sgdata.world.appearance.
             sample_appearance`), written with ``parts`` (:func:`sgdata.usd.looks.
@@ -83,9 +83,9 @@ def write_layout(
         raise SceneError(f"layout {index} seed {seed} does not fit USD's int64; use one < 2**63")
     layer = Sdf.Layer.CreateAnonymous(".usda")
     layer.subLayerPaths.append(f"./{ROOM_FILE}")
-    layer.defaultPrim = own.default_prim if own else ROOT.name
-    layer.pseudoRoot.SetInfo(UsdGeom.Tokens.upAxis, own.up_axis if own else UsdGeom.Tokens.z)
-    layer.pseudoRoot.SetInfo(UsdGeom.Tokens.metersPerUnit, own.meters_per_unit if own else 1.0)
+    layer.defaultPrim = user.default_prim if user else ROOT.name
+    layer.pseudoRoot.SetInfo(UsdGeom.Tokens.upAxis, user.up_axis if user else UsdGeom.Tokens.z)
+    layer.pseudoRoot.SetInfo(UsdGeom.Tokens.metersPerUnit, user.meters_per_unit if user else 1.0)
     try:
         moves_json = json.dumps(moves, sort_keys=True, allow_nan=False, default=_plain)
     except (TypeError, ValueError) as exc:
@@ -105,7 +105,7 @@ def write_layout(
                 f"layout {index}: instance {old.instance} is a {new.class_name} in the layout "
                 f"but a {old.class_name} in room {base.room_id}"
             )
-        _override(layer, old, new, before, after, own)
+        _override(layer, old, new, before, after, user)
         if appearance is not None and parts is not None and old.instance in appearance.looks:
             override_look(layer, parts, old.instance, appearance.looks[old.instance], materials)
     if appearance is not None and parts is not None:
@@ -120,7 +120,7 @@ def _override(
     new: SceneObject,
     objects: dict[int, SceneObject],
     after: dict[int, SceneObject],
-    own: OwnFrame | None,
+    user: UserFrame | None,
 ) -> None:
     a, b = old.placement, new.placement
     moved = any(
@@ -130,10 +130,10 @@ def _override(
     resupported = old.support != new.support
     if not (moved or resupported):
         return
-    where = Sdf.Path(own.paths[old.instance]) if own else object_path(old)
+    where = Sdf.Path(user.paths[old.instance]) if user else object_path(old)
     spec = Sdf.CreatePrimInLayer(layer, where)
-    if moved and own is not None:
-        override_own(layer, own, objects, after, old.instance)
+    if moved and user is not None:
+        override_user(layer, user, objects, after, old.instance)
     elif moved:
         translate = Sdf.AttributeSpec(
             spec, "xformOp:translate", Sdf.ValueTypeNames.Double3, Sdf.VariabilityVarying, False
@@ -154,7 +154,7 @@ def _override(
                 )
             target = objects[new.support]
             rel.targetPathList.explicitItems = [
-                Sdf.Path(own.paths[target.instance]) if own else object_path(target)
+                Sdf.Path(user.paths[target.instance]) if user else object_path(target)
             ]
 
 

@@ -1,102 +1,12 @@
-"""Layout overrides for rooms authored elsewhere: moves written as each prim's own local matrix.
+"""Deprecated home of :mod:`sgdata.usd.user_layouts` (renamed, with ``OwnFrame`` ->
+``UserFrame``, ``own_frame`` -> ``user_frame``, ``override_own`` -> ``override_user``); it
+re-exports the old names for one release."""
 
-An object of a measured room (:mod:`sgdata.usd.own_rooms`) may sit anywhere in the hierarchy,
-under transformed parents, in another up axis and unit. A layout moves it by the rigid motion
-``D = new placement @ old placement^-1`` (room frame); its layer overrides the prim with one
-``xformOp:transform`` whose value keeps the prim's geometry where ``D`` puts it, allowing for
-an ancestor object that moved too.
-"""
-
-from __future__ import annotations
-
-from dataclasses import dataclass
-from pathlib import Path
-
-import numpy as np
-from pxr import Gf, Sdf, Usd, UsdGeom
-
-from sgdata.usd.own_rooms import is_measured, measure_stage
-from sgdata.usd.stage import open_stage
-from sgdata.usd.stage_frame import room_prim, stage_frame, up_and_units
-from sgdata.world.scene import SceneObject
+from sgdata.deprecation import warn_moved
+from sgdata.usd.user_layouts import UserFrame as OwnFrame
+from sgdata.usd.user_layouts import override_user as override_own
+from sgdata.usd.user_layouts import user_frame as own_frame
 
 __all__ = ["OwnFrame", "own_frame", "override_own"]
 
-
-@dataclass(frozen=True)
-class OwnFrame:
-    """What a layout of a measured room needs to know about its base stage."""
-
-    paths: dict[int, str]  # instance -> object prim path
-    frame: np.ndarray  # stage -> room frame (4x4, column convention)
-    worlds: dict[int, np.ndarray]  # instance -> the prim's stage-space local-to-world matrix
-    parents: dict[int, np.ndarray]  # instance -> its parent prim's local-to-world matrix
-    owners: dict[int, int | None]  # instance -> the nearest ancestor object, if any
-    up_axis: str
-    meters_per_unit: float
-    default_prim: str
-
-
-def own_frame(room_path: Path) -> OwnFrame | None:
-    """The :class:`OwnFrame` of a measured room stage (``room.usda`` written by ``sgdata tag``).
-
-    ``None`` for a room written by ``sgdata rooms`` (its layouts override by placement).
-    """
-    stage = open_stage(room_path)
-    if not is_measured(stage):
-        return None
-    measured = measure_stage(stage, Path(room_path))
-    frame = stage_frame(stage)
-    frame = np.eye(4) if frame is None else frame
-    cache = UsdGeom.XformCache(Usd.TimeCode.Default())
-    by_path = {p: i for i, p in measured.paths.items()}
-    worlds, parents, owners = {}, {}, {}
-    for instance, key in measured.paths.items():
-        prim = stage.GetPrimAtPath(key)
-        worlds[instance] = np.array(cache.GetLocalToWorldTransform(prim)).T
-        parents[instance] = np.array(cache.GetLocalToWorldTransform(prim.GetParent())).T
-        owner = None
-        for prefix in reversed(prim.GetPath().GetParentPath().GetPrefixes()):
-            if str(prefix) in by_path:
-                owner = by_path[str(prefix)]
-                break
-        owners[instance] = owner
-    scale = float(np.linalg.norm(up_and_units(stage)[:3, 0]))
-    return OwnFrame(
-        measured.paths,
-        frame,
-        worlds,
-        parents,
-        owners,
-        str(UsdGeom.GetStageUpAxis(stage)),
-        scale,
-        room_prim(stage).GetName(),
-    )
-
-
-def override_own(
-    layer: Sdf.Layer,
-    own: OwnFrame,
-    before: dict[int, SceneObject],
-    after: dict[int, SceneObject],
-    instance: int,
-) -> None:
-    """Override one moved object of ``layer`` with its new local matrix."""
-    motion = _motion(before[instance], after[instance])
-    owner = own.owners[instance]
-    parent_motion = np.eye(4) if owner is None else _motion(before[owner], after[owner])
-    parent = parent_motion @ own.frame @ own.parents[instance]
-    local = np.linalg.inv(parent) @ motion @ own.frame @ own.worlds[instance]
-    spec = Sdf.CreatePrimInLayer(layer, Sdf.Path(own.paths[instance]))
-    matrix = Sdf.AttributeSpec(
-        spec, "xformOp:transform", Sdf.ValueTypeNames.Matrix4d, Sdf.VariabilityVarying, False
-    )
-    matrix.default = Gf.Matrix4d(local.T.tolist())
-    order = Sdf.AttributeSpec(
-        spec, "xformOpOrder", Sdf.ValueTypeNames.TokenArray, Sdf.VariabilityUniform, False
-    )
-    order.default = ["xformOp:transform"]
-
-
-def _motion(old: SceneObject, new: SceneObject) -> np.ndarray:
-    return new.placement.matrix() @ np.linalg.inv(old.placement.matrix())
+warn_moved("sgdata.usd.own_layouts", "sgdata.usd.user_layouts")

@@ -2,7 +2,7 @@
 
 Writers (:mod:`sgdata.usd.room_io`, :mod:`sgdata.usd.looks`, :mod:`sgdata.usd.materials`,
 :mod:`sgdata.usd.tagging`) and readers (:mod:`sgdata.usd.geometry`,
-:mod:`sgdata.usd.stage_frame`, :mod:`sgdata.usd.own_rooms`) import these names from here, so
+:mod:`sgdata.usd.stage_frame`, :mod:`sgdata.usd.user_rooms`) import these names from here, so
 this module imports nothing of sgdata's at run time and can never close an import circle.
 """
 

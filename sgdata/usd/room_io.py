@@ -319,7 +319,7 @@ def read_room(path: Path) -> Room:
     """Read a room back from ``room.usda``, or the composed room of a ``layout_<k>.usda``.
 
     A stage not written by :func:`write_room` (no ``sgdata:roomSize``, or tagged by
-    ``sgdata tag``) is measured from its geometry (:mod:`sgdata.usd.own_rooms`).
+    ``sgdata tag``) is measured from its geometry (:mod:`sgdata.usd.user_rooms`).
 
     Raises:
         UsdError: the file is missing, unreadable, does not compose, or lacks a ``sgdata:*``
@@ -327,7 +327,7 @@ def read_room(path: Path) -> Room:
     """
     path = Path(path)
     stage = open_stage(path)
-    from sgdata.usd.own_rooms import is_measured, measure_stage  # late: it reads geometry
+    from sgdata.usd.user_rooms import is_measured, measure_stage  # late: it reads geometry
 
     if is_measured(stage):  # a room authored elsewhere, tagged or not
         return measure_stage(stage, path).room

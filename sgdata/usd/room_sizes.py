@@ -7,8 +7,8 @@ from pathlib import Path
 from pxr import Usd, UsdGeom
 
 from sgdata.errors import UsdError
-from sgdata.usd.own_rooms import MeasuredRoom
 from sgdata.usd.stage_frame import meters_per_unit, room_prim
+from sgdata.usd.user_rooms import MeasuredRoom
 
 __all__ = ["check_sizes"]
 
@@ -32,7 +32,7 @@ def check_sizes(
     Args:
         stage: the composed stage ``measured`` was read from.
         path: its file, named in the message.
-        measured: the room :func:`sgdata.usd.own_rooms.measure_stage` read.
+        measured: the room :func:`sgdata.usd.user_rooms.measure_stage` read.
         max_room: metres; the config's ``[rooms] max_room_size``.
         max_object: metres; the config's ``[rooms] max_object_size``.
 

@@ -10,8 +10,8 @@ from sgdata.scene_files import LAYOUT_FILE, ROOM_FILE, layout_file, room_file
 from sgdata.seeds import appearance_seed, layouts_seed
 from sgdata.usd.layout_layers import write_layout
 from sgdata.usd.looks import read_room_parts
-from sgdata.usd.own_layouts import own_frame
 from sgdata.usd.room_io import catalog_geometry, read_room, write_room
+from sgdata.usd.user_layouts import user_frame
 from sgdata.world.appearance import AppearanceConfig, sample_appearance
 from sgdata.world.catalog import Catalog, load_catalog
 from sgdata.world.dynamics import DynamicsConfig, Layout, sample_layouts
@@ -102,7 +102,7 @@ def write_layouts(
     layouts = sample_layouts(
         base, count, layouts_seed(base.seed, seed), catalog, config, poses=poses
     )
-    own = own_frame(room_file(room_dir))  # None for rooms written by 'sgdata rooms'
+    user = user_frame(room_file(room_dir))  # None for rooms written by 'sgdata rooms'
     parts = None
     if appearance is not None and appearance.randomize:
         parts = read_room_parts(room_file(room_dir))
@@ -117,7 +117,7 @@ def write_layouts(
             index=layout.index,
             seed=layout.seed,
             moves=[m.as_dict() for m in layout.moves],
-            own=own,
+            user=user,
             appearance=drawn,
             parts=parts,
         )

@@ -3,7 +3,7 @@
 The user's file is never written: the tag layer (by default ``<stem>_sgdata/room.usda`` beside
 it, a room directory that ``sgdata layouts`` and ``sgdata render`` take) sublayers it and holds
 ``over`` specs with only the ``sgdata:*`` values the file lacks, measured by
-:mod:`sgdata.usd.own_rooms`, plus ``sgdata:roomOrigin`` and ``sgdata:placements = "measured"``
+:mod:`sgdata.usd.user_rooms`, plus ``sgdata:roomOrigin`` and ``sgdata:placements = "measured"``
 (objects keep their own frames; placements are measured from geometry on every read).
 Objects whose class the class file makes an alias get the catalog class as ``sgdata:class``.
 
@@ -22,11 +22,11 @@ from pxr import Gf, Sdf, Usd, UsdGeom
 
 from sgdata.errors import ConfigError
 from sgdata.scene_files import ROOM_FILE
-from sgdata.usd.own_rooms import MEASURED, measure_stage
 from sgdata.usd.prims import ROOM_ORIGIN
 from sgdata.usd.room_io import read_room
 from sgdata.usd.stage import open_stage, validate_stage, write_text_atomic
 from sgdata.usd.stage_frame import room_prim
+from sgdata.usd.user_rooms import MEASURED, measure_stage
 from sgdata.world.catalog import Catalog, load_catalog
 from sgdata.world.room_checks import room_problems
 from sgdata.world.scene import Room

@@ -9,9 +9,9 @@ from pxr import Gf, Sdf, Usd, UsdGeom
 
 from sgdata.errors import UsdError
 from sgdata.usd.geometry import read_geometry
-from sgdata.usd.own_rooms import measure_stage
 from sgdata.usd.room_sizes import check_sizes
 from sgdata.usd.stage import open_stage
+from sgdata.usd.user_rooms import measure_stage
 
 from .user_stages import write_user_room
 

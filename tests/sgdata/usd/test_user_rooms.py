@@ -1,4 +1,4 @@
-"""Own rooms: hand-written USD stages (any up axis and unit) tagged, read, laid out and rendered."""
+"""User rooms: hand-written USD stages (any up axis and unit) tagged, read, laid out, rendered."""
 
 from __future__ import annotations
 
