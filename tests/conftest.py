@@ -230,6 +230,24 @@ def mini_dataset(tmp_path_factory: pytest.TempPathFactory, mini_config_file: Pat
     return root
 
 
+# The mini dataset with the optional channels on (depth and instance masks): the channel
+# checks, the COCO / YOLO exports and the loader's channel tensors read it.
+CHANNELS_TOML = MINI_TOML + "[outputs]\ndepth = true\ninstances = true\n"
+
+
+@pytest.fixture(scope="session")
+def channels_dataset(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Root of the mini dataset generated with ``[outputs] depth`` and ``instances`` on."""
+    from sgdata.pipeline.config import load_config
+    from sgdata.pipeline.generate import generate_dataset
+
+    config_file = tmp_path_factory.mktemp("channels_config") / "channels.toml"
+    config_file.write_text(CHANNELS_TOML)
+    root = tmp_path_factory.mktemp("channels_dataset") / "data"
+    generate_dataset(load_config(config_file), root, workers=2)
+    return root
+
+
 # --------------------------------------------------------------------------- processes
 
 

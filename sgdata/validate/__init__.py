@@ -2,7 +2,8 @@
 
 One entry point, :func:`validate_dataset`, runs the check families in order (see
 docs/validate.md): manifest, files, metadata (card and Croissant), tables,
-rows/objects/relations, relation recompute, triplets, images, scenes, and with ``sources`` the
+rows/objects/relations, relation recompute, triplets, images, channels (depth and masks),
+scenes, and with ``sources`` the
 user room files. Nothing stops at the
 first failure: the report lists every :class:`Problem` with its file, row and field.
 """
@@ -14,6 +15,7 @@ from pathlib import Path
 
 from sgdata.dataset.schema import FORMAT_VERSION, _parse_version
 from sgdata.validate.appearance_checks import check_appearance
+from sgdata.validate.channel_checks import CHANNEL_CHECKS, check_channels
 from sgdata.validate.composition_checks import (
     check_counts,
     check_rooms_across_splits,
@@ -69,6 +71,7 @@ def validate_dataset(
     if quick:
         out.skipped.append("images.decode")
         out.skipped.append("images.size")
+        out.skipped.extend(CHANNEL_CHECKS)
     if not usd:
         out.skipped.append("scenes.usd")
     return ValidationReport(
@@ -99,6 +102,7 @@ def _check_contents(root: Path, raw: dict, out: Collector, *, quick: bool, usd: 
         check_triplets(tables, raw, out)
         if not quick:
             check_images(root, tables.files, out)
+            check_channels(root, raw, tables.files, out)
     check_rooms_across_splits(splits, out)
     check_counts(splits, raw, out)
     check_scenes(root, splits, out, usd=usd)

@@ -11,6 +11,7 @@ import pyarrow as pa
 import pyarrow.compute as pc
 import pyarrow.parquet as pq
 
+from sgdata.dataset.channels import CHANNELS
 from sgdata.dataset.paths import observations_path, triplets_path
 from sgdata.dataset.schema import (
     FORMAT_VERSION,
@@ -141,7 +142,7 @@ def load_split(
         if not (root / rel).is_file():
             continue  # reported by files.exist
         _schema_check(root, rel, obs_wanted, out, extra_ok)
-        table = read_table_as(root / rel, obs_schema, skip=("image",))
+        table = read_table_as(root / rel, obs_schema, skip=("image", *CHANNELS))
         if isinstance(table, str):
             out.add("tables.schema", rel, f"rows not checked: {table}")
             continue
