@@ -22,21 +22,44 @@ def _runs(seed_offsets: list[float], room_spread: float = 0.0) -> np.ndarray:
     return np.array([[0.8 + s + r for r in rooms] for s in seed_offsets])
 
 
-def test_seed_variance_widens_the_interval_where_rooms_alone_see_none() -> None:
-    # every room alike: a room bootstrap alone would give a zero-width interval
-    same_seeds = two_level_interval(_runs([0.0, 0.0, 0.0]), WEIGHT)
-    assert same_seeds["low"] == same_seeds["high"] == pytest.approx(0.8)
-    spread = two_level_interval(_runs([-0.03, 0.0, 0.03]), WEIGHT)
-    assert spread["mean"] == pytest.approx(0.8)
-    # resampling 3 seeds with replacement reaches their extremes' mean
-    assert spread["low"] == pytest.approx(0.77) and spread["high"] == pytest.approx(0.83)
+def test_three_seeds_keep_the_t_intervals_width() -> None:
+    # the issue's example: seeds at 0.72, 0.75 and 0.795, every room alike. A percentile
+    # bootstrap over the seeds gave [0.720, 0.795]; the seeds' t-interval is +- 9.4 points
+    seeds = [0.72, 0.75, 0.795]
+    t = t_interval(seeds)
+    assert t["ci95"] == pytest.approx(0.0938, abs=1e-4)
+    matrix = np.array([[s] * ROOMS for s in seeds])
+    two = two_level_interval(matrix, WEIGHT)
+    assert two["mean"] == pytest.approx(0.755)
+    assert two["high"] - two["mean"] >= t["ci95"] - 1e-12
+    assert two["mean"] - two["low"] >= t["ci95"] - 1e-12
+    assert two["low"] < 0.72 and two["high"] > 0.795  # wider than the seeds' range
+    assert two["seeds"] == 3 and two["room_se"] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_same_seeds_and_rooms_give_a_point() -> None:
+    same = two_level_interval(_runs([0.0, 0.0, 0.0]), WEIGHT)
+    assert same["low"] == pytest.approx(0.8) and same["high"] == pytest.approx(0.8)
 
 
 def test_room_and_seed_variance_add_up() -> None:
     rooms_only = two_level_interval(_runs([0.0, 0.0, 0.0], room_spread=0.1), WEIGHT)
+    seeds_only = two_level_interval(_runs([-0.03, 0.0, 0.03]), WEIGHT)
     both = two_level_interval(_runs([-0.03, 0.0, 0.03], room_spread=0.1), WEIGHT)
-    assert rooms_only["high"] - rooms_only["low"] > 0
-    assert both["high"] - both["low"] > rooms_only["high"] - rooms_only["low"]
+    # the rooms' standard error: the spread of 20 room effects over sqrt(20)
+    effects = np.linspace(-0.1, 0.1, ROOMS)
+    assert rooms_only["room_se"] == pytest.approx(effects.std() / ROOMS**0.5, rel=0.05)
+    assert seeds_only["seed_se"] == pytest.approx(0.03 / 3**0.5)
+    # variances add: the half-widths (same t quantile) add in quadrature
+    assert both["half"] ** 2 == pytest.approx(
+        rooms_only["half"] ** 2 + seeds_only["half"] ** 2, rel=1e-6
+    )
+
+
+def test_one_seed_has_the_rooms_interval_alone() -> None:
+    one = two_level_interval(_runs([0.0], room_spread=0.1), WEIGHT)
+    assert one["seeds"] == 1 and one["seed_se"] == 0.0
+    assert one["half"] == pytest.approx(1.959964 * one["room_se"])
 
 
 def test_paired_difference_cancels_shared_room_effects_and_keeps_seed_spread() -> None:
@@ -46,8 +69,12 @@ def test_paired_difference_cancels_shared_room_effects_and_keeps_seed_spread() -
     d = two_level_difference(a, b, WEIGHT)
     assert d["mean"] == pytest.approx(0.05)
     assert d["low"] == pytest.approx(0.05) and d["high"] == pytest.approx(0.05)  # paired
+    noisy_a = [0.82, 0.85, 0.88]
     noisy = two_level_difference(_runs([0.02, 0.05, 0.08], room_spread=0.15), b, WEIGHT)
-    assert noisy["low"] == pytest.approx(0.02) and noisy["high"] == pytest.approx(0.08)
+    # B's seeds agree: the difference's interval is A's seeds' t-interval, shifted
+    assert noisy["half"] == pytest.approx(t_interval(noisy_a)["ci95"])
+    welch = welch_difference(noisy_a, [0.8, 0.8, 0.8])
+    assert noisy["high"] >= welch["high"] - 1e-12 and noisy["low"] <= welch["low"] + 1e-12
     assert two_level_difference(a, b, WEIGHT) == d  # a fixed resampling seed
 
 
