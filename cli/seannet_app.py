@@ -10,6 +10,7 @@ from rich.console import Console
 from rich.table import Table
 from sgdata_cli.errors import run_app
 
+from seannet.navigation.config import FUSIONS, MAP_SPACING, NavigationTestConfig, NavigatorConfig
 from sgdata.errors import SgdataError
 
 app = typer.Typer(
@@ -22,6 +23,9 @@ app = typer.Typer(
 console = Console()
 
 Data = Annotated[Path, typer.Option("--data", help="Dataset root (made by sgdata generate).")]
+# the defaults of the navigator and of the navigation test: their config dataclasses'
+NAVIGATOR = NavigatorConfig()
+NAVIGATION_TEST = NavigationTestConfig()
 
 
 @app.command()
@@ -227,7 +231,9 @@ def build_map(
         list[str] | None, typer.Option(help="Map only these rooms (repeatable).")
     ] = None,
     layout: Annotated[int, typer.Option(help="Layout the map is built in.")] = 0,
-    spacing: Annotated[int, typer.Option(help="Cells between map nodes (the authors: 2).")] = 2,
+    spacing: Annotated[int, typer.Option(help="Cells between map nodes (the authors').")] = (
+        MAP_SPACING
+    ),
 ) -> None:
     """Build topological maps (rendered sub-nodes + the run's embeddings), reused if present."""
     from seannet.data.datasets import open_dataset
@@ -268,27 +274,38 @@ def localize(
 def train_navigator_command(
     data: Data,
     out: Annotated[Path, typer.Option("--out", help="Run directory for the navigator.")],
-    epochs: Annotated[int, typer.Option(help="Epochs over the rendered pairs.")] = 10,
-    pairs: Annotated[int, typer.Option(help="Train pairs rendered from the train rooms.")] = 2000,
-    val_pairs: Annotated[int, typer.Option(help="Val pairs (best.pt by their accuracy).")] = 400,
-    image_size: Annotated[int, typer.Option(help="Navigator input size, pixels.")] = 96,
-    encoder: Annotated[str, typer.Option(help="Shared image encoder.")] = "resnet18",
-    batch_size: Annotated[int, typer.Option(help="Pairs per SGD step.")] = 32,
+    epochs: Annotated[int, typer.Option(help="Epochs over the rendered pairs.")] = NAVIGATOR.epochs,
+    pairs: Annotated[int, typer.Option(help="Train pairs rendered from the train rooms.")] = (
+        NAVIGATOR.train_pairs
+    ),
+    val_pairs: Annotated[int, typer.Option(help="Val pairs (best.pt by their accuracy).")] = (
+        NAVIGATOR.val_pairs
+    ),
+    image_size: Annotated[
+        int, typer.Option(help="Navigator input size, pixels.")
+    ] = NAVIGATOR.image_size,
+    encoder: Annotated[str, typer.Option(help="Shared image encoder.")] = NAVIGATOR.encoder,
+    batch_size: Annotated[int, typer.Option(help="Pairs per SGD step.")] = NAVIGATOR.batch_size,
     pretrained: Annotated[
         Path | None, typer.Option(help="Local ImageNet weights of --encoder, sha256-checked.")
     ] = None,
-    seed: Annotated[int, typer.Option(help="Seed of pairs, weights and batch order.")] = 0,
+    seed: Annotated[
+        int, typer.Option(help="Seed of pairs, weights and batch order.")
+    ] = NAVIGATOR.seed,
     cache: Annotated[
         Path | None,
         typer.Option(help="Rendered pairs, kept and reused (default: OUT/../navigator_pairs)."),
     ] = None,
     cross_layout: Annotated[
         float, typer.Option(help="Share of pairs whose goal view is of another layout.")
-    ] = 0.0,
-    jitter: Annotated[float, typer.Option(help="Brightness / contrast jitter, +- share.")] = 0.0,
+    ] = NAVIGATOR.cross_layout,
+    jitter: Annotated[float, typer.Option(help="Brightness / contrast jitter, +- share.")] = (
+        NAVIGATOR.jitter
+    ),
     fusion: Annotated[
-        str, typer.Option(help="early: the two views stacked as 6 channels; late: siamese.")
-    ] = "early",
+        str,
+        typer.Option(help=f"{' | '.join(FUSIONS)}: the two views stacked as 6 channels | siamese."),
+    ] = NAVIGATOR.fusion,
 ) -> None:
     """Train the visual navigator (forward / left / right) on pairs rendered from the rooms."""
     from rich.progress import Progress
@@ -336,14 +353,18 @@ def navigate(
     oracle: Annotated[
         bool, typer.Option(help="Navigate with the right action from the true pose instead.")
     ] = False,
-    split: Annotated[str, typer.Option(help="Rooms to test in.")] = "test",
-    episodes: Annotated[int, typer.Option(help="Episodes per case (N, A) and room.")] = 20,
-    seed: Annotated[int, typer.Option(help="Seed of the episodes.")] = 0,
-    spacing: Annotated[int, typer.Option(help="Cells between map nodes.")] = 2,
+    split: Annotated[str, typer.Option(help="Rooms to test in.")] = NAVIGATION_TEST.split,
+    episodes: Annotated[int, typer.Option(help="Episodes per case (N, A) and room.")] = (
+        NAVIGATION_TEST.episodes
+    ),
+    seed: Annotated[int, typer.Option(help="Seed of the episodes.")] = NAVIGATION_TEST.seed,
+    spacing: Annotated[
+        int, typer.Option(help="Cells between map nodes.")
+    ] = NAVIGATION_TEST.spacing,
     epsilon: Epsilon = None,
     replan: Annotated[
         bool, typer.Option(help="Also report bump and replan (beyond the paper).")
-    ] = False,
+    ] = NAVIGATION_TEST.replan,
     workers: Annotated[int, typer.Option(help="Worker processes (rooms in parallel).")] = 1,
     out: Annotated[
         Path | None, typer.Option(help="Where to write (default: the navigator run).")
@@ -359,13 +380,15 @@ def navigate(
 
     if (navigator is None) == (not oracle):
         raise NavigationError("give one of --navigator RUN and --oracle")
+    config = NavigationTestConfig(
+        split=split, episodes=episodes, seed=seed, spacing=spacing, replan=replan
+    )
     with console.status("navigate") as status:
         result = run_navigation(
-            runs, navigator, data, split=split, episodes=episodes, seed=seed, spacing=spacing,
-            epsilon=epsilon, replan=replan, workers=workers, out=out, maps=maps, strips=strips,
-            progress=status.update,
+            runs, navigator, data, config, epsilon=epsilon, workers=workers, out=out, maps=maps,
+            strips=strips, progress=status.update,
         )  # fmt: skip
-    for rule in ("paper", "replan") if replan else ("paper",):
+    for rule in config.rules:
         table = Table(title=f"{rule} rule, {split} of {data} ({episodes} episodes per case, room)")
         for column in RATE_HEADER:
             table.add_column(column, justify="right")

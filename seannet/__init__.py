@@ -4,9 +4,12 @@ Laid out by stage, imports going downwards only (docs/architecture.md): ``data``
 triplets as tensors) < ``model`` (SeanNet, baselines, layers, loss) < ``training`` (config,
 the one training loop, run directories) < ``evaluation`` (metrics, ``seannet eval``,
 ``compare``) < ``navigation`` (maps, localization, the navigator and its test). This face
-re-exports the most used names lazily: ``import seannet`` loads no torch.
+re-exports the most used names lazily: ``import seannet`` loads no torch. Importing it reads
+the code's commit once (:data:`seannet.provenance.PROCESS`), so what runs record is the code
+this process loaded, not whatever HEAD is when they finish.
 """
 
+from seannet import provenance as _provenance  # noqa: F401  (the code state at process start)
 from sgdata.lazy_face import lazy_face
 
 _EXPORTS = {

@@ -8,7 +8,9 @@ _EXPORTS = {
     "load_localizer": ".localizer",
     "TopoMap": ".maps",
     "build_maps": ".maps",
-    "NavigatorConfig": ".navigator",
+    "NavigationTestConfig": ".config",
+    "NavigatorConfig": ".config",
+    "run_navigation": ".benchmark",
     "load_navigator": ".navigator",
     "train_navigator": ".navigator_training",
 }

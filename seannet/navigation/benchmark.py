@@ -21,8 +21,10 @@ bytes for the same settings whatever the worker count or the interruptions.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import time
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -34,17 +36,35 @@ from seannet.data.datasets import dataset_identity, open_dataset
 from seannet.data.live_views import LiveRooms
 from seannet.errors import NavigationError
 from seannet.model.pretrained import file_sha256
-from seannet.navigation.episodes import CASES, K_MAX, EpisodeResult, run_episode, sample_episode
+from seannet.navigation.config import MAP_SPACING, NavigationTestConfig
+from seannet.navigation.episodes import CASES, EpisodeResult, run_episode, sample_episode
 from seannet.navigation.localizer import Localizer, load_localizer
-from seannet.navigation.maps import check_map, current_map, ensure_map, load_map
+from seannet.navigation.maps import (
+    MAP_META,
+    check_map,
+    current_map,
+    derive_map,
+    ensure_map,
+    load_map,
+    save_map,
+)
 from seannet.navigation.navigator import load_navigator, resize
 from seannet.navigation.tables import markdown, write_results
+from seannet.provenance import append_provenance
 from seannet.training.runs import BEST, check_same_dataset, load_checkpoint
 from sgdata.fileio import atomic_write_text, save_png
 from sgdata.pipeline.executors import run_tasks
 from sgdata.seeds import episode_seed, rng_for
 
-__all__ = ["ORACLE", "draw_strip", "run_labels", "run_navigation"]
+__all__ = [
+    "ORACLE",
+    "NavigationTestConfig",
+    "draw_strip",
+    "results_path",
+    "run_labels",
+    "run_navigation",
+    "seed_maps",
+]
 
 ORACLE = "oracle"  # the navigator that takes the right action from the true pose
 STRIP_PANEL = 112  # pixels
@@ -56,41 +76,39 @@ def run_navigation(
     runs: list[Path],
     navigator: Path | None,
     data: Path,
+    config: NavigationTestConfig | None = None,
     *,
-    split: str = "test",
-    episodes: int = 20,
-    seed: int = 0,
-    k_max: int = K_MAX,
-    spacing: int = 2,
     epsilon: float | dict[Path, tuple[float, str]] | None = None,
-    replan: bool = False,
     workers: int = 1,
     out: Path | None = None,
     maps: Path | None = None,
     strips: Path | None = None,
     progress: Callable[[str], None] | None = None,
+    **settings: Any,
 ) -> dict[str, Any]:
-    """Run the navigation test of every localizer run on the rooms of ``split``.
+    """Run the navigation test of every localizer run on the rooms of ``config.split``.
 
     Args:
         navigator: a ``train-navigator`` run; None for the oracle (:data:`ORACLE`).
-        replan: run every episode under bump and replan; its paper-rule outcome is read off
-            the same run (see :mod:`seannet.navigation.episodes`).
+        config: the test's settings (default :class:`NavigationTestConfig`'s); with
+            ``replan`` every episode runs under bump and replan and its paper-rule outcome is
+            read off the same run (see :mod:`seannet.navigation.episodes`).
         workers: processes running maps and episodes in parallel.
         epsilon: one threshold for every run, or per run ``(epsilon, where it comes from)``
             (a run left out reads its eval files); None: each run's eval files.
+        settings: deprecated: the config's fields as keywords (``split=``, ``episodes=``...).
 
     Writes ``navigate_<split>.json`` and ``.md`` into ``out`` (default: the navigator run),
     maps under ``maps`` (default: ``out/maps``), and under ``strips`` when given, per run,
-    room and case, the first episode of each outcome (and cause or kind) as a strip.
+    room and case, the first episode of each outcome (and cause or kind) as a strip; appends
+    what made them to ``out``'s provenance (:mod:`seannet.provenance`).
 
     Raises:
         CheckpointError: a run or the navigator was trained on another dataset.
         NavigationError: bad counts, no epsilon for a run, a split without rooms, a room
             without an episode, or no ``out`` for the oracle.
     """
-    if episodes < 1:
-        raise NavigationError(f"--episodes {episodes}: expected >= 1 per case and room")
+    config = _config(config, settings)
     if workers < 1:
         raise NavigationError(f"--workers {workers}: expected >= 1")
     out = out if out is not None else navigator
@@ -103,31 +121,19 @@ def run_navigation(
         check_same_dataset(navigator / BEST, state["dataset"], identity)
         load_navigator(navigator)  # refuses a localizer run given as the navigator, here
     ds = open_dataset(data)
-    rooms = list(ds.rooms(split)) if split in ds.splits else []
+    rooms = list(ds.rooms(config.split)) if config.split in ds.splits else []
     if not rooms:
-        raise NavigationError(f"{data}: split {split!r} has no room to navigate in")
+        raise NavigationError(f"{data}: split {config.split!r} has no room to navigate in")
     say = progress or (lambda _: None)
     localizers = [_localizer(run, data, epsilon) for run in runs]
     settings = {
-        "split": split,
-        "episodes_per_case_and_room": episodes,
-        "seed": seed,
-        "k_max": k_max,
-        "spacing": spacing,
-        "replan": replan,
+        **config.settings(),
         "navigator": str(navigator) if navigator is not None else ORACLE,
         "navigator_sha256": file_sha256(navigator / BEST) if navigator is not None else ORACLE,
         "dataset": identity,
     }
     labels = dict(zip(runs, run_labels(runs), strict=True))
-    map_jobs = [
-        (loc.run, data, room_id, maps / labels[loc.run] / room_id, spacing)
-        for loc in localizers
-        for room_id in rooms
-        if current_map(loc, room_id, maps / labels[loc.run] / room_id, spacing=spacing) is None
-    ]
-    for done in run_tasks(_map_task, map_jobs, workers=workers):
-        say(f"map of {done['room_id']} by {done['run']}")
+    _build_maps(localizers, data, rooms, {r: maps / labels[r] for r in runs}, config, workers, say)
     jobs = {
         (loc.run, room_id, case): {
             **settings,
@@ -147,16 +153,12 @@ def run_navigation(
     todo = [(job, str(data), str(out)) for job in jobs.values() if _part(job, out) is None]
     for done in run_tasks(_case_task, todo, workers=workers):
         say(f"{done['label']}: {done['room_id']} {done['case']} done")
-    results: dict[str, Any] = {**settings, "runs": []}
+    results: dict[str, Any] = {**settings, "config": dataclasses.asdict(config), "runs": []}
     for loc in localizers:
-        records = []
-        for room_id in rooms:
-            for case in CASES:
-                part = _part(jobs[loc.run, room_id, case], out)
-                if part is None:
-                    path = _part_path(jobs[loc.run, room_id, case], out)
-                    raise NavigationError(f"{path}: missing after its task ran")
-                records += part
+        records = [
+            episode for room_id in rooms for case in CASES
+            for episode in _finished_part(jobs[loc.run, room_id, case], out)
+        ]  # fmt: skip
         results["runs"].append(
             {
                 "run": str(loc.run),
@@ -169,10 +171,87 @@ def run_navigation(
             }
         )
     out.mkdir(parents=True, exist_ok=True)
-    write_results(results, out / f"navigate_{split}.json")
-    atomic_write_text(out / f"navigate_{split}.md", markdown(results))
-    results["written"] = str(out / f"navigate_{split}.md")
+    append_provenance(out, data, step=results_path(out, config.split).stem)
+    write_results(results, results_path(out, config.split))
+    written = results_path(out, config.split).with_suffix(".md")
+    atomic_write_text(written, markdown(results))
+    results["written"] = str(written)
     return results
+
+
+def results_path(out: Path, split: str) -> Path:
+    """Where :func:`run_navigation` writes its results JSON for ``split`` (markdown beside)."""
+    return out / f"navigate_{split}.json"
+
+
+def _config(config: NavigationTestConfig | None, settings: dict[str, Any]) -> NavigationTestConfig:
+    """``config`` with the deprecated keyword settings of before 2026-12-03 applied."""
+    config = config if config is not None else NavigationTestConfig()
+    if not settings:
+        return config
+    unknown = sorted(set(settings) - {f.name for f in dataclasses.fields(config)})
+    if unknown:
+        raise TypeError(f"run_navigation() got unexpected keyword arguments {unknown}")
+    warnings.warn(
+        f"run_navigation({', '.join(f'{k}=' for k in settings)}...) is deprecated: pass "
+        "NavigationTestConfig(...) as config",
+        DeprecationWarning,
+        stacklevel=3,
+    )
+    return config.replace(**settings)
+
+
+def _build_maps(
+    localizers: list[Localizer],
+    data: Path,
+    rooms: list[str],
+    directories: dict[Path, Path],
+    config: NavigationTestConfig,
+    workers: int,
+    say: Callable[[str], None],
+) -> None:
+    """Build the maps of every run and room that are missing or stale (in workers)."""
+    jobs = [
+        (loc.run, data, room_id, directories[loc.run] / room_id, config.spacing)
+        for loc in localizers
+        for room_id in rooms
+        if current_map(loc, room_id, directories[loc.run] / room_id, spacing=config.spacing) is None
+    ]
+    for done in run_tasks(_map_task, jobs, workers=workers):
+        say(f"map of {done['room_id']} by {done['run']}")
+
+
+def _finished_part(job: dict[str, Any], out: Path) -> list[dict[str, Any]]:
+    part = _part(job, out)
+    if part is None:
+        raise NavigationError(f"{_part_path(job, out)}: missing after its task ran")
+    return part
+
+
+def seed_maps(
+    runs: list[Path],
+    full_maps: dict[Path, Path],
+    rooms: list[str],
+    maps: Path,
+    *,
+    spacing: int = MAP_SPACING,
+) -> list[Path]:
+    """Put into :func:`run_navigation`'s map cache ``maps``, for each run of ``full_maps``
+    and each room, the map it would build, derived from that run's spacing-1 map in
+    ``full_maps[run]/<room>`` (e.g. a full-map recall's): the same views and embeddings, not
+    rendered again. Maps already there are kept; a derived map of another checkpoint is found
+    stale by :func:`run_navigation` and built anew. Returns the maps written."""
+    written = []
+    for run, label in zip(runs, run_labels(runs), strict=True):
+        source = full_maps.get(run)
+        if source is None:
+            continue
+        for room_id in rooms:
+            target = maps / label / room_id
+            if not (target / MAP_META).is_file() and (source / room_id / MAP_META).is_file():
+                save_map(derive_map(load_map(source / room_id), spacing), target)
+                written.append(target)
+    return written
 
 
 def _localizer(

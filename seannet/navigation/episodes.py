@@ -35,6 +35,7 @@ import numpy as np
 
 from seannet.data.live_views import LiveRooms
 from seannet.errors import MapError, NavigationError
+from seannet.navigation.config import K_MAX
 from seannet.navigation.localizer import Localizer
 from seannet.navigation.maps import TopoMap
 from seannet.navigation.motion import (
@@ -73,7 +74,6 @@ __all__ = [
     "step_verdict",
 ]
 
-K_MAX = 12  # steps per segment (paper §VI-B)
 POSITION_TOLERANCE = 0.5  # cells: "within half a cell" of the goal
 ANGLE_TOLERANCE_DEG = 10.0
 CASES = ("N", "A")  # neighbour sub-nodes / arbitrary sub-nodes

@@ -34,6 +34,7 @@ import pyarrow.parquet as pq
 
 from seannet.data.live_views import LiveRooms
 from seannet.errors import MapError
+from seannet.navigation.config import MAP_SPACING
 from seannet.navigation.localizer import Localizer
 from seannet.navigation.motion import HEADINGS
 from sgdata.dataset import decode_image
@@ -199,7 +200,12 @@ class TopoMap:
 
 
 def build_map(
-    localizer: Localizer, live: LiveRooms, room_id: str, *, layout: int = 0, spacing: int = 2
+    localizer: Localizer,
+    live: LiveRooms,
+    room_id: str,
+    *,
+    layout: int = 0,
+    spacing: int = MAP_SPACING,
 ) -> TopoMap:
     """Render every sub-node of ``room_id``'s ``layout`` and embed it with ``localizer``.
 
@@ -360,7 +366,12 @@ def check_map(topo: TopoMap, localizer: Localizer, where: Path) -> None:
 
 
 def current_map(
-    localizer: Localizer, room_id: str, directory: Path, *, layout: int = 0, spacing: int = 2
+    localizer: Localizer,
+    room_id: str,
+    directory: Path,
+    *,
+    layout: int = 0,
+    spacing: int = MAP_SPACING,
 ) -> TopoMap | None:
     """The map in ``directory`` if this run built it for ``room_id`` with these parameters;
     None when it is missing, stale or damaged (then it is to be built again)."""
@@ -381,7 +392,7 @@ def ensure_map(
     directory: Path,
     *,
     layout: int = 0,
-    spacing: int = 2,
+    spacing: int = MAP_SPACING,
 ) -> TopoMap:
     """The map in ``directory`` if it was built by this run with these parameters, else a new
     one built and saved there."""
@@ -414,7 +425,7 @@ def build_maps(
     out: Path,
     *,
     layout: int = 0,
-    spacing: int = 2,
+    spacing: int = MAP_SPACING,
 ) -> list[Path]:
     """Build (or reuse) one map per room into ``out/<room_id>/``; their directories."""
     done = []

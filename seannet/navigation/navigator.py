@@ -10,10 +10,7 @@ same heading; the label is the larger displacement). Rendering pairs is in
 from __future__ import annotations
 
 import copy
-import dataclasses
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 import torch
@@ -22,7 +19,8 @@ from torch import Tensor, nn
 from seannet.data.batch import normalise_pixels
 from seannet.data.view_inputs import ImageTransform
 from seannet.errors import CheckpointError, ModelError
-from seannet.model.backbones import ENCODER_NAMES, image_encoder
+from seannet.model.backbones import image_encoder
+from seannet.navigation.config import FUSIONS, NavigatorConfig
 from seannet.navigation.motion import FORWARD, HEADINGS, NAVIGATOR_ACTIONS, local_offset
 from seannet.training.runs import BEST, device_for_run, load_checkpoint
 from seannet.weights import normalisation
@@ -40,7 +38,6 @@ __all__ = [
 ]
 
 KIND = "navigator"  # checkpoints say what they hold: a localizer run is refused here
-FUSIONS = ("early", "late")  # NavigatorConfig.fusion
 
 
 def resize(rgb: np.ndarray, size: int) -> np.ndarray:
@@ -56,67 +53,6 @@ def navigator_inputs(images: np.ndarray, encoder: str = "resnet18") -> Tensor:
 
 
 _NO_BOXES = np.zeros((0, 4), dtype=np.float32)
-
-
-@dataclass(frozen=True)
-class NavigatorConfig:
-    """Everything a navigator run depends on; stored in its checkpoints."""
-
-    encoder: str = "resnet18"  # torchvision image encoder (the paper: VGG-16)
-    # "early": the two views stacked as six input channels, so the first convolution already
-    # compares them pixel by pixel (what a relative-pose answer needs); "late": a siamese
-    # encoder whose pooled features are concatenated (it must say where things are in a
-    # vector that pooling has made blind to position)
-    fusion: str = "early"
-    image_size: int = 96  # square input (64..112 keeps a CPU run short)
-    hidden: int = 256  # MLP width after the concatenated features
-    epochs: int = 10
-    batch_size: int = 32
-    lr: float = 0.01  # SGD, as the authors
-    momentum: float = 0.9
-    train_pairs: int = 2000  # pairs rendered from the train rooms (all epochs reuse them)
-    val_pairs: int = 400  # from the val rooms: accuracy every epoch picks best.pt
-    max_side: int = 2  # goal within +-max_side cells sideways ...
-    max_forward: int = 4  # ... and 0..max_forward cells forward
-    # What the test changes: its goal is the map's view of layout 0 while the robot walks in
-    # another layout (moved objects, their looks, the light). Share of pairs whose goal view
-    # is rendered in another layout of the room than the current view (train and val alike):
-    cross_layout: float = 0.0
-    jitter: float = 0.0  # train-time brightness and contrast jitter, +- this share, per view
-    seed: int = 0
-
-    def __post_init__(self) -> None:
-        if self.encoder not in ENCODER_NAMES:
-            raise ModelError(
-                f"navigator.encoder {self.encoder!r}: expected one of {', '.join(ENCODER_NAMES)}"
-            )
-        if self.fusion not in FUSIONS:
-            raise ModelError(
-                f"navigator.fusion {self.fusion!r}: expected one of {', '.join(FUSIONS)}"
-            )
-        for name in ("image_size", "hidden", "epochs", "batch_size", "train_pairs"):
-            if getattr(self, name) < 1:
-                raise ModelError(f"navigator.{name} must be >= 1, got {getattr(self, name)}")
-        if self.image_size < 32:
-            raise ModelError(f"navigator.image_size {self.image_size}: expected >= 32 pixels")
-        if self.val_pairs < 0 or self.max_side < 0 or self.max_forward < 0:
-            raise ModelError("navigator: val_pairs, max_side and max_forward must be >= 0")
-        if self.max_side + self.max_forward < 1:
-            raise ModelError("navigator: max_side + max_forward must be >= 1 (a goal must move)")
-        if not 0 <= self.cross_layout <= 1 or not 0 <= self.jitter < 1:
-            raise ModelError(
-                f"navigator: cross_layout {self.cross_layout} must be within [0, 1], "
-                f"jitter {self.jitter} within [0, 1)"
-            )
-        if self.lr <= 0 or not 0 <= self.momentum < 1:
-            raise ModelError(f"navigator: lr {self.lr} must be > 0, momentum within [0, 1)")
-
-    def replace(self, **changes: Any) -> NavigatorConfig:
-        """A copy with some fields changed (validated again)."""
-        return dataclasses.replace(self, **changes)
-
-    def to_dict(self) -> dict[str, Any]:
-        return dataclasses.asdict(self)
 
 
 class VisualNavigator(nn.Module):

@@ -30,6 +30,7 @@ from seannet.errors import CheckpointError
 from seannet.navigation.motion import NAVIGATOR_ACTIONS
 from seannet.navigation.navigator import KIND, NavigatorConfig, VisualNavigator, navigator_inputs
 from seannet.navigation.pairs import PairSet, render_pairs
+from seannet.provenance import append_provenance
 from seannet.training.loop import Progress, collect, train_one_epoch
 from seannet.training.runs import BEST, HISTORY, LAST, device_for_run, save_checkpoint
 from sgdata.fileio import atomic_write_text
@@ -70,6 +71,7 @@ def train_navigator(
     if (out / LAST).exists():
         raise CheckpointError(f"{out}: holds a navigator run already; pick another --out")
     identity = dataset_identity(data)
+    append_provenance(out, data, step="train-navigator")
     if progress is not None:
         progress("render", 0, 1, {})
     with LiveRooms(data) as live:

@@ -24,7 +24,7 @@ import numpy as np
 
 from seannet.data.live_views import LiveRooms
 from seannet.errors import DataError
-from seannet.navigation.motion import NAVIGATOR_ACTIONS, local_offset
+from seannet.navigation.motion import local_offset
 from seannet.navigation.navigator import NavigatorConfig, draw_pair, resize
 from sgdata.fileio import atomic_write_bytes, atomic_write_text
 from sgdata.seeds import navigator_pairs_seed, rng_for
@@ -58,9 +58,6 @@ class PairSet:
             [sum(map(abs, local_offset(tuple(p[1:4]), tuple(p[5:7])))) for p in self.poses],
             dtype=np.int64,
         )
-
-    def action_names(self) -> list[str]:
-        return [NAVIGATOR_ACTIONS[int(k)] for k in self.labels]
 
 
 def pairs_key(config: NavigatorConfig, split: str, count: int, identity: dict[str, Any]) -> dict:

@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from seannet.errors import NavigationError
+from seannet.navigation.config import RULES
 from seannet.navigation.episodes import CASES, CAUSES, LOCALIZATION_KINDS, OUTCOMES
 from sgdata.fileio import atomic_write_text
 
@@ -26,7 +27,6 @@ __all__ = [
 ]
 
 Z95 = 1.959963984540054  # the standard normal's 97.5 % quantile
-RULES = ("paper", "replan")  # a collision ends the episode / bump and replan
 # what a row counts: the outcomes, then the two kinds of each failure the issue splits
 DETAILS = (*LOCALIZATION_KINDS, *CAUSES)
 TIME_PARTS = ("render", "embed", "navigator", "total")
@@ -138,7 +138,7 @@ def _table(header: list[str], rows: list[list[str]]) -> list[str]:
 def markdown(results: dict[str, Any]) -> str:
     """``navigate_<split>.md``: the paper-rule table, its failure split, the ``--replan``
     table when run, time per episode, each run's epsilon."""
-    rules = ["paper", "replan"] if results.get("replan") else ["paper"]
+    rules = RULES if results.get("replan") else RULES[:1]
     lines = [
         f"# Navigation test on {results['split']} (paper Table II)",
         "",

@@ -26,6 +26,7 @@ from seannet.data.datasets import (
 from seannet.errors import CheckpointError
 from seannet.model.loss import TripletLoss
 from seannet.model.pretrained import check_pretrained_request
+from seannet.provenance import append_provenance
 from seannet.training.config import TrainConfig
 from seannet.training.loop import Progress, collect, train_one_epoch, triplet_correct, triplet_step
 from seannet.training.runs import (
@@ -120,7 +121,7 @@ def train(
         history, best, start_epoch = state["history"], state["best"], state["epoch"] + 1
     elif last.exists():
         raise CheckpointError(f"{out}: holds a run already; pass --resume or pick another --out")
-    out.mkdir(parents=True, exist_ok=True)
+    append_provenance(out, data, step="resume" if resume else "train")  # makes ``out``
     loss_fn = TripletLoss(config.margin)
     results = [EpochResult(**h) for h in history]
     for epoch in range(start_epoch, config.epochs):

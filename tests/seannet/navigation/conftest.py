@@ -8,11 +8,12 @@ from types import SimpleNamespace
 import pytest
 
 from seannet.navigation.benchmark import run_navigation
+from seannet.navigation.config import NavigationTestConfig
 from seannet.navigation.navigator import NavigatorConfig
 from seannet.navigation.navigator_training import train_navigator
 
 # What the tiny navigation run used: the kill-and-resume test runs it again with these.
-TINY_NAVIGATION = {"episodes": 2, "epsilon": 0.95, "replan": True}
+TINY_NAVIGATION = {"config": NavigationTestConfig(episodes=2, replan=True), "epsilon": 0.95}
 
 
 @pytest.fixture(scope="session")

@@ -18,6 +18,7 @@ import torch
 from seannet.data.live_views import LiveRooms
 from seannet.errors import ModelError, NavigationError
 from seannet.navigation.benchmark import run_navigation
+from seannet.navigation.config import NavigationTestConfig
 from seannet.navigation.episodes import (
     OUTCOMES,
     Step,
@@ -214,8 +215,8 @@ def test_a_stop_threshold_per_localizer_and_where_it_comes_from(
 ) -> None:
     given = {localizer_run: (0.25, "navigation on val")}
     results = run_navigation(
-        [localizer_run], navigation_run.navigator, mini_dataset, episodes=1, epsilon=given,
-        out=tmp_path, maps=navigation_run.out / "maps",
+        [localizer_run], navigation_run.navigator, mini_dataset, NavigationTestConfig(episodes=1),
+        epsilon=given, out=tmp_path, maps=navigation_run.out / "maps",
     )  # fmt: skip
     (run,) = results["runs"]
     assert (run["epsilon"], run["epsilon_source"]) == (0.25, "navigation on val")
