@@ -452,24 +452,67 @@ def import_(
 
 @app.command(name="export")
 def export(
-    fmt: Annotated[str, typer.Argument(metavar="FORMAT", help="labelstudio")],
+    fmt: Annotated[str, typer.Argument(metavar="FORMAT", help="coco | labelstudio | yolo")],
     dataset: Annotated[Path, typer.Argument(help="Dataset root (holding dataset.json).")],
-    output: Annotated[Path, typer.Option("-o", "--output", help="Label Studio JSON to write.")],
+    output: Annotated[
+        Path,
+        typer.Option(
+            "-o", "--output", help="coco, yolo: the folder to write; labelstudio: the JSON file."
+        ),
+    ],
     images: Annotated[
         Path | None,
-        typer.Option("--images", help="Where the images go (default: <output stem>_images/)."),
+        typer.Option(
+            "--images", help="labelstudio: where the images go (default: <output stem>_images/)."
+        ),
     ] = None,
+    split: Annotated[
+        str | None, typer.Option("--split", help="coco, yolo: export this split only.")
+    ] = None,
+    masks: Annotated[
+        bool,
+        typer.Option("--masks", help="coco: RLE segmentations from the instance masks."),
+    ] = False,
+    force: Annotated[
+        bool, typer.Option("--force", help="coco, yolo: replace a non-empty output folder.")
+    ] = False,
 ) -> None:
-    """Write a dataset's boxes and relations as Label Studio JSON, and its images as files."""
+    """Write a dataset for other tools: COCO or YOLO (detector trainers: boxes, masks and
+    image files) or Label Studio JSON (boxes and relations)."""
     from sgdata.errors import ConfigError
-    from sgdata.label.labelstudio import export_labelstudio
+    from sgdata.label.detector_files import check_format
 
-    if fmt != "labelstudio":
-        raise ConfigError(f"format {fmt!r}: expected labelstudio")
-    done = export_labelstudio(dataset, output, images_dir=images)
+    check_format(fmt)
+    if fmt == "labelstudio":
+        from sgdata.label.labelstudio import export_labelstudio
+
+        if split or masks or force:
+            raise ConfigError("--split, --masks and --force are for coco and yolo exports")
+        done = export_labelstudio(dataset, output, images_dir=images)
+        console.print(
+            f"wrote {done.tasks} task(s), {done.boxes} box(es) and {done.relations} relation(s) "
+            f"to {done.path}; images in {done.images}"
+        )
+        return
+    if images is not None:
+        raise ConfigError(f"--images is for labelstudio; {fmt} writes images under -o")
+    if fmt == "coco":
+        from sgdata.label.coco_export import export_coco
+
+        coco = export_coco(dataset, output, split=split, masks=masks, force=force)
+        console.print(
+            f"wrote {coco.images} image(s) and {coco.annotations} annotation(s)"
+            f"{' with RLE masks' if coco.masks else ''} to {coco.root} "
+            f"({', '.join(f.name for f in coco.files)})"
+        )
+        return
+    if masks:
+        raise ConfigError("--masks is for coco; YOLO detection labels hold boxes")
+    from sgdata.label.yolo_export import export_yolo
+
+    yolo = export_yolo(dataset, output, split=split, force=force)
     console.print(
-        f"wrote {done.tasks} task(s), {done.boxes} box(es) and {done.relations} relation(s) "
-        f"to {done.path}; images in {done.images}"
+        f"wrote {yolo.images} image(s) and {yolo.boxes} box(es) to {yolo.root} (data.yaml)"
     )
 
 
