@@ -29,6 +29,7 @@ from sgdata.dataset.paths import SPLITS
 from sgdata.errors import ConfigError, SgdataError
 from sgdata.render.camera import CameraConfig
 from sgdata.world.appearance import AppearanceConfig
+from sgdata.world.catalog import Catalog, load_catalog
 from sgdata.world.dynamics import DynamicsConfig
 from sgdata.world.poses import PosesConfig
 from sgdata.world.room_recipes import ROOM_TYPES
@@ -37,6 +38,8 @@ from sgdata.world.triplets import DEFAULT_SHARES, check_shares
 __all__ = [
     "PRESETS",
     "AnnotationConfig",
+    "AssetFile",
+    "CatalogConfig",
     "DatasetConfig",
     "GenerateConfig",
     "ImagesConfig",
@@ -176,6 +179,44 @@ class RoomsConfig:
 
 
 @dataclass(frozen=True)
+class AssetFile:
+    """A file the user's catalog reads (the catalog file, a mesh, a texture) with its SHA-256,
+    filled in by generation (:func:`sgdata.pipeline.user_assets.resolve_user_assets`)."""
+
+    SHORTHAND: ClassVar[str] = "path"  # a bare string in TOML sets this field
+
+    path: str  # relative to the config file's folder (or absolute)
+    sha256: str = ""
+
+    def __post_init__(self) -> None:
+        if not self.path:
+            raise ConfigError("catalog.assets: an entry with an empty path")
+        if self.sha256 and not re.fullmatch(r"[0-9a-f]{64}", self.sha256):
+            raise ConfigError(
+                f"catalog.assets entry {self.path!r}: sha256 {self.sha256!r}; expected 64 "
+                "lower-case hex digits"
+            )
+
+
+@dataclass(frozen=True)
+class CatalogConfig:
+    """The object catalog: the shipped one merged with the user's catalog files, whose classes
+    may be made of mesh files (docs/rooms.md, "Objects you bring")."""
+
+    files: tuple[str, ...] = ()  # user catalog files, relative to the config's folder, in order
+    assets: tuple[AssetFile, ...] = ()  # filled by generation: every file they read, hashed
+    base_dir: str = field(default="", metadata=INTERNAL, compare=False)  # the config's folder
+
+    def paths(self) -> tuple[Path, ...]:
+        """The user catalog files, resolved against the config's folder."""
+        return tuple(Path(self.base_dir or ".") / Path(p).expanduser() for p in self.files)
+
+    def load(self) -> Catalog:
+        """The catalog of a run: the shipped one with :meth:`paths` merged in (cached)."""
+        return load_catalog(extra=self.paths())
+
+
+@dataclass(frozen=True)
 class LayoutsConfig:
     """How many layouts each room gets (layout 0 is the base arrangement)."""
 
@@ -262,6 +303,7 @@ class GenerateConfig:
     images: ImagesConfig = field(default_factory=ImagesConfig)
     appearance: AppearanceConfig = field(default_factory=AppearanceConfig)  # [appearance]
     outputs: OutputsConfig = field(default_factory=OutputsConfig)  # [outputs]: extra channels
+    catalog: CatalogConfig = field(default_factory=CatalogConfig, metadata=SPARSE)  # [catalog]
 
 
 def load_config(source: str | Path) -> GenerateConfig:
@@ -283,7 +325,11 @@ def load_config(source: str | Path) -> GenerateConfig:
     if isinstance(source, str) and source in PRESETS:
         return config
     folder = str(Path(source).resolve().parent)
-    return dataclasses.replace(config, rooms=dataclasses.replace(config.rooms, base_dir=folder))
+    return dataclasses.replace(
+        config,
+        rooms=dataclasses.replace(config.rooms, base_dir=folder),
+        catalog=dataclasses.replace(config.catalog, base_dir=folder),
+    )
 
 
 def config_to_dict(config: Any) -> Any:
@@ -292,13 +338,20 @@ def config_to_dict(config: Any) -> Any:
         return {
             f.name: config_to_dict(getattr(config, f.name))
             for f in _public_fields(config)
-            if not (f.metadata.get("sparse") and getattr(config, f.name) == f.default)
+            if not (f.metadata.get("sparse") and getattr(config, f.name) == _default(f))
         }
     if isinstance(config, dict):
         return {str(k): config_to_dict(v) for k, v in config.items()}
     if isinstance(config, tuple | list):
         return [config_to_dict(v) for v in config]
     return config
+
+
+def _default(f: dataclasses.Field) -> Any:
+    """A field's default value (made by its factory when it has one)."""
+    if f.default_factory is not dataclasses.MISSING:
+        return f.default_factory()
+    return f.default
 
 
 def _read(source: str | Path) -> tuple[str, str]:

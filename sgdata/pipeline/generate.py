@@ -88,7 +88,8 @@ def generate_dataset(
 
     The rooms of ``[rooms] files`` are checked and hashed first
     (:func:`sgdata.pipeline.user_rooms.resolve_user_rooms`): the manifest's config records each
-    file's sha256 and room type.
+    file's sha256 and room type; so are the files of ``[catalog] files``
+    (:func:`sgdata.pipeline.user_assets.resolve_user_assets`).
 
     Raises:
         ConfigError: ``root`` is a file, holds a finished dataset (without ``force``), holds
@@ -96,10 +97,16 @@ def generate_dataset(
             config (on ``resume``); a ``[rooms] files`` entry or the class file is missing.
         UsdError: a user room has no ``sgdata:class`` prim, a class the catalog lacks (and
             the class file maps onto none), or cannot be read.
+        CatalogError: a ``[catalog] files`` catalog is malformed or one of its mesh files is
+            bad (:mod:`sgdata.world.mesh_assets`); nothing is written.
         DatasetError: a file cannot be written (the run can be resumed once fixed).
     """
     if workers < 1:
         raise ConfigError(f"--workers must be >= 1, got {workers}")
+    if config.catalog.files:  # the user's catalogs read, their meshes checked and hashed
+        from sgdata.pipeline.user_assets import resolve_user_assets
+
+        config = resolve_user_assets(config)
     if config.rooms.files:  # checked and hashed before anything is written
         from sgdata.pipeline.user_rooms import resolve_user_rooms
 
@@ -171,7 +178,7 @@ def _finish(
             files.append(file_entry(root, usd.relative_to(root).as_posix(), rows=None))
     for image in sorted((root / SCENE_TEXTURES).glob("*.png")):  # shared by textured rooms
         files.append(file_entry(root, image.relative_to(root).as_posix(), rows=None))
-    slots, classes = class_vocabulary()
+    slots, classes = class_vocabulary(config.catalog.load())
     manifest = Manifest(
         name=config.dataset.name,
         version=config.dataset.version,

@@ -17,7 +17,6 @@ from sgdata.errors import DatasetError
 from sgdata.pipeline.ledger import read_record, scene_record, views_record, write_record
 from sgdata.scene_files import layout_file, room_file
 from sgdata.seeds import rng_for, view_seed
-from sgdata.world.catalog import load_catalog
 
 if TYPE_CHECKING:
     from sgdata.pipeline.config import GenerateConfig
@@ -50,7 +49,7 @@ def write_room_scenes(task: RoomTask, config: GenerateConfig, root: Path) -> dic
     from sgdata.usd.scene_dirs import write_layouts
     from sgdata.world.rooms import generate_room
 
-    catalog = load_catalog()
+    catalog = config.catalog.load()
     room_dir = scene_dir(root, task.room_id)
     if task.name:  # a user's room: its stage copied in, tagged
         entry = config.rooms.files[task.index]
@@ -156,7 +155,7 @@ def _annotator(config: GenerateConfig) -> tuple[Any, dict[str, int]]:
 
         if "renderer" in _worker:
             _worker["renderer"].close()
-        slots, classes = class_vocabulary()
+        slots, classes = class_vocabulary(config.catalog.load())
         renderer = Renderer(config.camera, textures=config.appearance.textures)
         _worker.update(
             key=key,

@@ -24,7 +24,7 @@ from sgdata.errors import ConfigError, SgdataError, UsdError
 from sgdata.pipeline.config import ROOM_TYPE_NAME, GenerateConfig, RoomFile, RoomsConfig
 from sgdata.scene_files import SOURCE_FILE, room_file
 from sgdata.seeds import user_room_seed
-from sgdata.world.catalog import Catalog, load_catalog
+from sgdata.world.catalog import Catalog
 from sgdata.world.scene import Room
 from sgdata.world.user_classes import UserClasses, read_class_file
 
@@ -51,7 +51,7 @@ def resolve_user_rooms(config: GenerateConfig, *, taken: Collection[str] = ()) -
         return config
     base = str(Path(rooms.base_dir or ".").resolve())
     rooms = dataclasses.replace(rooms, base_dir=base)
-    catalog = load_catalog()
+    catalog = config.catalog.load()
     classes = _class_file(rooms, catalog)
     resolved = []
     for k, entry in enumerate(rooms.files):

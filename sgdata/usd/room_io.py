@@ -79,19 +79,20 @@ _FLOAT3, _COLOR3F = Sdf.ValueTypeNames.Float3, Sdf.ValueTypeNames.Color3f
 
 
 def catalog_geometry(catalog: Catalog | None = None) -> Geometry:
-    """The default geometry source: each object's catalog recipe, merged into one mesh.
+    """The default geometry source: each object's catalog recipe (or mesh file), merged into
+    one mesh.
 
     Args:
         catalog: the catalog naming each class's recipe; the shipped one when ``None``.
     """
     from sgdata.world.catalog import load_catalog  # late: the catalog and recipes pull in trimesh
-    from sgdata.world.shapes import build_shape, merged_mesh
+    from sgdata.world.mesh_assets import class_shape
+    from sgdata.world.shapes import merged_mesh
 
     cat = catalog if catalog is not None else load_catalog()
 
     def geometry(obj: SceneObject) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        spec = cat[obj.class_name]
-        return merged_mesh(build_shape(spec.shape, obj.size, obj.variant, obj.color))
+        return merged_mesh(class_shape(cat[obj.class_name], obj.size, obj.variant, obj.color))
 
     return geometry
 

@@ -34,7 +34,7 @@ from sgdata.validate.problems import Collector, Problem, ValidationReport
 from sgdata.validate.relation_checks import check_recompute
 from sgdata.validate.scene_checks import check_scenes
 from sgdata.validate.source_checks import CHECK as SOURCES_CHECK
-from sgdata.validate.source_checks import check_sources, user_room_files
+from sgdata.validate.source_checks import catalog_asset_files, check_sources, user_room_files
 from sgdata.validate.table_checks import check_ids, compare_schema, load_split
 
 __all__ = ["Problem", "ValidationReport", "compare_schema", "validate_dataset"]
@@ -50,7 +50,8 @@ def validate_dataset(
         quick: skip decoding the images (the slowest check).
         usd: also run USD's validators on every referenced scene layer.
         sources: the folder of the config that generated the dataset: its ``[rooms] files``
-            must still have the sha256 the manifest records.
+            and the files of its ``[catalog]`` (catalogs, meshes, textures) must still have the
+            sha256 the manifest records.
 
     Returns:
         the report; ``report.ok`` is True only when no check failed.
@@ -66,7 +67,7 @@ def validate_dataset(
         _check_contents(root, raw, out, quick=quick, usd=usd)
         if sources is not None:
             check_sources(raw, Path(sources), out)
-        elif user_room_files(raw):
+        elif user_room_files(raw) or catalog_asset_files(raw):
             out.skipped.append(SOURCES_CHECK)
     if quick:
         out.skipped.append("images.decode")

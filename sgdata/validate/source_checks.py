@@ -1,10 +1,11 @@
-"""Source checks (``--sources DIR``): the user's room files a dataset was made from are unchanged.
+"""Source checks (``--sources DIR``): the user's files a dataset was made from are unchanged.
 
 A dataset generated from ``[rooms] files`` records each file's path (relative to the config
 file's folder) and SHA-256 in its manifest's ``config.rooms.files``; its scenes hold a flattened
-copy (``scenes/<room>/source.usda``, checked by ``files.sha256``). Given the config's folder, this
-check names every user file that is missing there or whose bytes are no longer those the dataset
-was made from.
+copy (``scenes/<room>/source.usda``, checked by ``files.sha256``). One made with ``[catalog]
+files`` records likewise its catalog files and every mesh and texture file they read, in
+``config.catalog.assets``. Given the config's folder, this check names every user file that is
+missing there or whose bytes are no longer those the dataset was made from.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from sgdata.dataset.paths import MANIFEST
 from sgdata.dataset.rows import sha256_file
 from sgdata.validate.problems import Collector
 
-__all__ = ["check_sources", "user_room_files"]
+__all__ = ["catalog_asset_files", "check_sources", "user_room_files"]
 
 CHECK = "sources.unchanged"
 
@@ -27,11 +28,21 @@ def user_room_files(raw: dict) -> list[dict]:
     return [f for f in files if isinstance(f, dict)] if isinstance(files, list) else []
 
 
+def catalog_asset_files(raw: dict) -> list[dict]:
+    """The ``config.catalog.assets`` entries of a raw manifest: the user's catalog files and
+    the mesh and texture files they read (empty without ``[catalog] files``)."""
+    catalog = raw.get("config", {}).get("catalog", {})
+    files = catalog.get("assets", []) if isinstance(catalog, dict) else []
+    return [f for f in files if isinstance(f, dict)] if isinstance(files, list) else []
+
+
 def check_sources(raw: dict, folder: Path, out: Collector) -> None:
-    """Each user room's file under ``folder`` has the sha256 the manifest records."""
-    for k, entry in enumerate(user_room_files(raw)):
+    """Each user room's file, and each file of the user's catalog (meshes, textures), under
+    ``folder`` has the sha256 the manifest records."""
+    entries = [(f"config.rooms.files[{k}]", e) for k, e in enumerate(user_room_files(raw))]
+    entries += [(f"config.catalog.assets[{k}]", e) for k, e in enumerate(catalog_asset_files(raw))]
+    for field, entry in entries:
         out.count(CHECK)
-        field = f"config.rooms.files[{k}]"
         rel, recorded = str(entry.get("path", "")), str(entry.get("sha256", ""))
         path = Path(folder) / rel
         if not rel or not path.is_file():

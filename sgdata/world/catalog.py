@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import glob
 import tomllib
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cache
 from importlib import resources
@@ -18,6 +20,7 @@ __all__ = [
     "WALL",
     "ClassSpec",
     "Catalog",
+    "MeshSource",
     "load_catalog",
     "default_catalog_path",
 ]
@@ -51,7 +54,33 @@ _FIELDS = {
     "description",
     "anchors",
     "anchor_sides",
+    # a class made of mesh files (sgdata.world.mesh_assets) instead of a recipe
+    "mesh",
+    "scale",
+    "up",
+    "units",
+    "front",
 }
+
+# The recipe name a mesh class reports as its ``shape`` (no recipe of that name exists).
+MESH_SHAPE = "mesh"
+MESH_SCALES = ("keep", "fit")  # keep the file's true size (within bounds) | scale it into them
+MESH_UPS = ("auto", "y", "z")  # the file's up axis; auto: measured against the size bounds
+MESH_UNITS = ("auto", "m", "cm", "mm")  # the file's unit; auto: measured likewise
+MESH_FRONTS = ("-y", "+y", "-x", "+x")  # the file's front axis, once its up axis is +Z
+
+
+@dataclass(frozen=True)
+class MeshSource:
+    """Where a mesh class's variants come from and how its files are read (one per file)."""
+
+    files: tuple[str, ...]  # absolute paths, sorted: variant k is files[k]
+    pattern: str  # the ``mesh`` value as written (for messages)
+    scale: str = "keep"  # one of MESH_SCALES
+    up: str = "auto"  # one of MESH_UPS
+    units: str = "auto"  # one of MESH_UNITS
+    front: str = "-y"  # one of MESH_FRONTS
+    recolor: bool = False  # a palette was given: its colours replace the main material's
 
 
 @dataclass(frozen=True)
@@ -73,6 +102,7 @@ class ClassSpec:
     description: str = ""
     anchors: tuple[str, ...] = ()  # floor classes: what it stands at, in order of preference
     anchor_sides: tuple[str, ...] = ()  # sides others stand at; () = by placement (see below)
+    mesh: MeshSource | None = None  # a class of mesh files (then ``shape`` is MESH_SHAPE)
 
     def sides_to_stand_at(self) -> tuple[str, ...]:
         """Sides of this class that an object anchored to it may stand at: ``anchor_sides``
@@ -113,33 +143,64 @@ def default_catalog_path() -> Path:
 
 
 @cache
-def _load_cached(path: str) -> Catalog:
-    return _parse(Path(path))
+def _load_cached(path: str, extra: tuple[str, ...]) -> Catalog:
+    return _parse(Path(path), tuple(Path(p) for p in extra))
 
 
-def load_catalog(path: str | Path | None = None) -> Catalog:
-    """Load and validate a catalog TOML file (the shipped one by default).
+def load_catalog(path: str | Path | None = None, *, extra: Sequence[str | Path] = ()) -> Catalog:
+    """Load and validate a catalog TOML file (the shipped one by default), merged with the
+    user's catalog files ``extra`` in order: a class of theirs is new (appended to the
+    vocabulary) or overrides the fields it names of a class before it (in place). A user's
+    class may name mesh files instead of a recipe (``mesh``, :mod:`sgdata.world.mesh_assets`),
+    relative to its own file's folder; those files are read and measured here.
 
     Raises:
-        CatalogError: naming the file, the class and the field at fault.
+        CatalogError: naming the file, the class and the field at fault (or the mesh file).
     """
     resolved = Path(path) if path is not None else default_catalog_path()
-    return _load_cached(str(resolved.resolve()))
+    extras = tuple(str(Path(p).resolve()) for p in extra)
+    return _load_cached(str(resolved.resolve()), extras)
 
 
-def _parse(path: Path) -> Catalog:
+def _read_table(path: Path) -> dict[str, Any]:
     try:
         data = tomllib.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise CatalogError(f"{path}: catalog file not found") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise CatalogError(f"{path}: cannot read the catalog file ({exc})") from None
     except tomllib.TOMLDecodeError as exc:
         raise CatalogError(f"{path}: not valid TOML ({exc})") from None
     table = data.get("classes")
     if not isinstance(table, dict) or not table:
         raise CatalogError(f"{path}: expected a [classes.<Name>] table per object class")
-    specs = {name: _parse_class(path, name, entry) for name, entry in table.items()}
-    _check_references(path, specs)
-    return Catalog(classes=specs, source=str(path))
+    for name, entry in table.items():
+        if not isinstance(entry, dict):
+            raise CatalogError(f"{path}: class {name}: expected a table of fields")
+    return table
+
+
+def _parse(path: Path, extra: tuple[Path, ...] = ()) -> Catalog:
+    entries: dict[str, tuple[Path, dict[str, Any]]] = {
+        name: (path, entry) for name, entry in _read_table(path).items()
+    }
+    for user_file in extra:
+        for name, entry in _read_table(user_file).items():
+            if name in entries and "mesh" not in entry:
+                entries[name] = (user_file, {**entries[name][1], **entry})
+            elif name in entries:  # a recipe class turned into mesh files: no recipe fields
+                kept = {k: v for k, v in entries[name][1].items() if k not in _RECIPE_ONLY}
+                entries[name] = (user_file, {**kept, **entry})
+            else:
+                entries[name] = (user_file, dict(entry))
+    specs = {name: _parse_class(where, name, entry) for name, (where, entry) in entries.items()}
+    source = " + ".join(str(p) for p in (path, *extra))
+    _check_references(Path(source), specs)
+    return Catalog(classes=specs, source=source)
+
+
+# fields of a recipe class that a mesh class (overriding it) does not inherit
+_RECIPE_ONLY = {"shape", "variants", "palette"}
 
 
 def _parse_class(path: Path, name: str, entry: Any) -> ClassSpec:
@@ -151,7 +212,19 @@ def _parse_class(path: Path, name: str, entry: Any) -> ClassSpec:
         raise CatalogError(
             f"{where}: unknown field {sorted(unknown)[0]!r}; known: {sorted(_FIELDS)}"
         )
-    for required in ("dynamics", "shape", "size_min", "size_max", "placement", "palette"):
+    is_mesh = "mesh" in entry
+    if is_mesh:
+        for recipe_only in ("shape", "variants"):
+            if recipe_only in entry:
+                raise CatalogError(
+                    f"{where}: field {recipe_only!r} is for recipe classes; a class with "
+                    f"'mesh' has one variant per file"
+                )
+    else:
+        for mesh_only in sorted(_MESH_ONLY & set(entry)):
+            raise CatalogError(f"{where}: field {mesh_only!r} needs a 'mesh' (files) field")
+    needed = ("dynamics", "size_min", "size_max", "placement")
+    for required in (*needed, *(() if is_mesh else ("shape", "palette"))):
         if required not in entry:
             raise CatalogError(f"{where}: missing field {required!r}")
     try:
@@ -182,7 +255,10 @@ def _parse_class(path: Path, name: str, entry: Any) -> ClassSpec:
     variants = entry.get("variants", 1)
     if not isinstance(variants, int) or variants < 1:
         raise CatalogError(f"{where}: field 'variants' must be an integer >= 1")
-    palette = entry["palette"]
+    mesh = _mesh_source(path, where, entry) if is_mesh else None
+    if mesh is not None:
+        variants = len(mesh.files)
+    palette = entry.get("palette", [_NEUTRAL])
     if not isinstance(palette, list) or not palette:
         raise CatalogError(
             f"{where}: field 'palette' must be a non-empty list of '#rrggbb' colours"
@@ -199,7 +275,7 @@ def _parse_class(path: Path, name: str, entry: Any) -> ClassSpec:
     return ClassSpec(
         name=name,
         dynamics=dynamics,
-        shape=str(entry["shape"]),
+        shape=MESH_SHAPE if is_mesh else str(entry["shape"]),
         size_min=size_min,
         size_max=size_max,
         placement=placement,
@@ -212,6 +288,52 @@ def _parse_class(path: Path, name: str, entry: Any) -> ClassSpec:
         description=str(entry.get("description", "")),
         anchors=anchors,
         anchor_sides=anchor_sides,
+        mesh=mesh,
+    )
+
+
+_MESH_ONLY = {"scale", "up", "units", "front"}
+_NEUTRAL = "#b3b3b3"  # the palette of a mesh class that keeps its files' colours (unused)
+
+
+def _mesh_source(path: Path, where: str, entry: dict[str, Any]) -> MeshSource:
+    """The files of a ``mesh`` field (a glob or a list of them, relative to ``path``'s folder)
+    and how to read them."""
+    value = entry["mesh"]
+    patterns = [value] if isinstance(value, str) else value
+    if not (
+        isinstance(patterns, list) and patterns and all(isinstance(p, str) and p for p in patterns)
+    ):
+        raise CatalogError(f"{where}: field 'mesh' must be a file glob or a list of them")
+    files: list[str] = []
+    for pattern in patterns:
+        full = Path(pattern).expanduser()
+        full = full if full.is_absolute() else path.parent / full
+        matched = sorted(p for p in glob.glob(str(full), recursive=True) if Path(p).is_file())
+        if not matched:
+            raise CatalogError(
+                f"{where}: field 'mesh' {pattern!r} matches no file (looked in "
+                f"{full.parent}); fix the path or the pattern"
+            )
+        files += [str(Path(p).resolve()) for p in matched if str(Path(p).resolve()) not in files]
+    options = {}
+    for key, allowed in (
+        ("scale", MESH_SCALES),
+        ("up", MESH_UPS),
+        ("units", MESH_UNITS),
+        ("front", MESH_FRONTS),
+    ):
+        if key in entry:
+            if entry[key] not in allowed:
+                raise CatalogError(
+                    f"{where}: field {key!r} is {entry[key]!r}; expected one of {allowed}"
+                )
+            options[key] = entry[key]
+    return MeshSource(
+        files=tuple(files),
+        pattern=value if isinstance(value, str) else ", ".join(patterns),
+        recolor="palette" in entry,
+        **options,
     )
 
 
@@ -247,7 +369,11 @@ def _check_references(path: Path, specs: dict[str, ClassSpec]) -> None:
     )
 
     for spec in specs.values():
-        if spec.shape not in RECIPES:
+        if spec.mesh is not None:
+            from sgdata.world.mesh_assets import class_assets  # late: reads the mesh files
+
+            class_assets(spec)  # every file read, checked and measured once, here
+        elif spec.shape not in RECIPES:
             raise CatalogError(
                 f"{path}: class {spec.name}: field 'shape' is {spec.shape!r}; "
                 f"no such recipe in sgdata.world.shapes"

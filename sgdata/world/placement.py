@@ -60,8 +60,14 @@ def shape_build(shape: str, size: tuple[float, float, float], variant: int) -> S
 
 
 def object_build(obj: SceneObject, catalog: Catalog) -> ShapeBuild:
-    """The cached recipe output for an object (surfaces and attachments do not depend on colour)."""
-    return shape_build(catalog[obj.class_name].shape, obj.size, obj.variant)
+    """The cached recipe (or mesh files') output for an object (surfaces and attachments do
+    not depend on colour)."""
+    spec = catalog[obj.class_name]
+    if spec.mesh is not None:
+        from sgdata.world.mesh_assets import mesh_build  # late: reads the files once
+
+        return mesh_build(spec, obj.size, obj.variant)
+    return shape_build(spec.shape, obj.size, obj.variant)
 
 
 def wall_yaw(wall: str) -> float:

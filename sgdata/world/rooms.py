@@ -117,6 +117,7 @@ class _RoomBuilder:
         self.by_instance: dict[int, SceneObject] = {}
         self.theme: dict[str, tuple[float, float, float]] = {}
         self.keepout = door_keepout(self.room)
+        self._mesh_variant = 0  # the file of the mesh class drawn last (see _mesh_size)
 
     # -- helpers -------------------------------------------------------------------------
     def _uniform(self, low: float, high: float, *, step: float = 0.0) -> float:
@@ -124,8 +125,23 @@ class _RoomBuilder:
         return round(value / step) * step if step else value
 
     def _size(self, spec: ClassSpec) -> tuple[float, float, float]:
+        if spec.mesh is not None:
+            return self._mesh_size(spec)
         lo, hi = np.array(spec.size_min), np.array(spec.size_max)
         return tuple(float(v) for v in np.round(lo + self.rng.random(3) * (hi - lo), 3))  # type: ignore[return-value]
+
+    def _mesh_size(self, spec: ClassSpec) -> tuple[float, float, float]:
+        """A mesh class's file is drawn first (its size is the file's): ``keep`` places it at
+        its measured size, ``fit`` at a uniform scale drawn within the class's bounds."""
+        from sgdata.world.mesh_assets import class_sizes  # late: reads the files once
+
+        self._mesh_variant = int(self.rng.integers(spec.variants))
+        size = np.array(class_sizes(spec)[self._mesh_variant])
+        if spec.mesh is not None and spec.mesh.scale == "fit":
+            low = float(np.max(np.array(spec.size_min) / size))
+            high = float(np.min(np.array(spec.size_max) / size))
+            size = size * (self._uniform(low, high) if low <= high else 1.0)
+        return tuple(float(v) for v in np.round(size, 4))  # type: ignore[return-value]
 
     def _color(self, spec: ClassSpec) -> tuple[float, float, float]:
         # Fixtures share one colour per class in a room (a kitchen's cabinets match).
@@ -146,7 +162,10 @@ class _RoomBuilder:
         *,
         support: int | None = None,
     ) -> SceneObject:
-        variant = int(self.rng.integers(spec.variants))
+        if spec.mesh is not None:  # drawn with its size (_mesh_size)
+            variant = self._mesh_variant
+        else:
+            variant = int(self.rng.integers(spec.variants))
         return SceneObject(
             instance=len(self.objects) + 1,
             class_name=spec.name,
@@ -236,7 +255,7 @@ class _RoomBuilder:
             if self._count(spec) >= spec.max_instances:
                 continue
             size = self._size(spec)
-            if spec.name != "Fridge" and spec.placement == "wall_floor":
+            if spec.name != "Fridge" and spec.placement == "wall_floor" and spec.mesh is None:
                 depth = float(np.clip(run_depth, spec.size_min[1], spec.size_max[1]))
                 height = round((spec.size_min[2] + spec.size_max[2]) / 2, 3)
                 size = (size[0], depth, height)
