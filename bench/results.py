@@ -49,8 +49,7 @@ from seannet.evaluation.eval import eval_file, evaluate_run, scene_term  # noqa:
 from seannet.navigation.localizer import load_localizer  # noqa: E402
 from seannet.navigation.map_localization import run_localize  # noqa: E402
 from seannet.navigation.maps import build_maps  # noqa: E402
-from sgdata.dataset.rows import sha256_file  # noqa: E402
-from sgdata.fileio import atomic_write_text  # noqa: E402
+from sgdata.fileio import atomic_write_text, sha256_file  # noqa: E402
 
 SEEDS = (0, 1, 2)
 LRS = (0.003, 0.01)

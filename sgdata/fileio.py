@@ -1,27 +1,44 @@
-"""Atomic file writes and output-directory checks: nothing half-written is ever left behind."""
+"""Files on disk: atomic writes (nothing half-written is ever left behind), output-directory
+checks, a file's SHA-256, and TOML files read into one-line errors.
+
+One protocol writes every file of the project: a temporary file beside the target
+(``.<name>.<random>.tmp``, :data:`TEMP_GLOB`), flushed to disk, then renamed over the target
+(:func:`atomic_file`); a failure removes the temporary file and leaves the target as it was.
+"""
 
 from __future__ import annotations
 
+import hashlib
 import io
 import os
 import tempfile
+import tomllib
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
-from PIL import Image
+from sgdata.errors import ConfigError, SgdataError, one_line
 
-from sgdata.errors import ConfigError
+if TYPE_CHECKING:
+    from PIL import Image
 
 __all__ = [
     "TEMP_GLOB",
+    "atomic_file",
     "atomic_write_bytes",
     "atomic_write_text",
+    "parse_toml",
     "prepare_output_dir",
+    "read_toml",
     "remove_stale_temps",
     "save_png",
+    "sha256_file",
 ]
 
 # Temporary files of atomic writes: ".<name>.<random>.tmp" beside the target.
 TEMP_GLOB = ".*.tmp"
+_HASH_CHUNK = 1 << 20  # bytes read at a time when hashing a file
 
 
 def prepare_output_dir(path: Path) -> Path:
@@ -41,17 +58,47 @@ def prepare_output_dir(path: Path) -> Path:
     return path
 
 
-def atomic_write_bytes(path: Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` through a temporary file in the same directory + rename."""
+@contextmanager
+def atomic_file(path: Path) -> Iterator[Path]:
+    """A temporary path beside ``path`` to write; on a clean exit it is synced to disk and
+    renamed over ``path``, on any error removed (``path`` untouched).
+
+    Raises:
+        OSError: the directory cannot be created or written (callers map it to their error).
+    """
+    path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    fd, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    os.close(fd)
+    tmp = Path(name)
     try:
-        with os.fdopen(fd, "wb") as handle:
-            handle.write(data)
+        yield tmp
+        fd = os.open(tmp, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
         os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def atomic_write_bytes(path: Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` atomically (:func:`atomic_file`)."""
+    with atomic_file(path) as tmp:
+        tmp.write_bytes(data)
+
+
+def atomic_write_text(path: Path, text: str) -> None:
+    """Write UTF-8 ``text`` to ``path`` atomically (:func:`atomic_file`)."""
+    atomic_write_bytes(path, text.encode("utf-8"))
+
+
+def save_png(image: Image.Image, path: Path) -> None:
+    """Write a PIL image as PNG atomically."""
+    buffer = io.BytesIO()
+    image.save(buffer, format="PNG")
+    atomic_write_bytes(path, buffer.getvalue())
 
 
 def remove_stale_temps(root: Path) -> int:
@@ -62,13 +109,39 @@ def remove_stale_temps(root: Path) -> int:
     return len(stale)
 
 
-def atomic_write_text(path: Path, text: str) -> None:
-    """Write UTF-8 ``text`` atomically."""
-    atomic_write_bytes(path, text.encode("utf-8"))
+def sha256_file(path: Path) -> tuple[str, int]:
+    """(sha256 hex digest, size in bytes) of a file, read in chunks."""
+    digest, size = hashlib.sha256(), 0
+    with open(path, "rb") as handle:
+        while chunk := handle.read(_HASH_CHUNK):
+            digest.update(chunk)
+            size += len(chunk)
+    return digest.hexdigest(), size
 
 
-def save_png(image: Image.Image, path: Path) -> None:
-    """Write a PIL image as PNG atomically (temp file + rename)."""
-    buffer = io.BytesIO()
-    image.save(buffer, format="PNG")
-    atomic_write_bytes(path, buffer.getvalue())
+def read_toml(path: Path, what: str, *, error: type[SgdataError] = ConfigError) -> dict[str, Any]:
+    """The top-level table of the TOML file ``path``; ``what`` names the file in messages
+    (``"class file"``: "class file not found", "cannot read the class file").
+
+    Raises:
+        ``error``: the file is missing, unreadable, not UTF-8 or not valid TOML.
+    """
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise error(f"{path}: {what} not found") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise error(f"{path}: cannot read the {what} ({one_line(exc)})") from None
+    return parse_toml(text, str(path), error=error)
+
+
+def parse_toml(text: str, where: str, *, error: type[SgdataError] = ConfigError) -> dict[str, Any]:
+    """The table of TOML ``text`` read from ``where`` (a file or a preset's name).
+
+    Raises:
+        ``error``: ``text`` is not valid TOML (the message names ``where``, line and column).
+    """
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise error(f"{where}: not valid TOML ({one_line(exc)})") from None

@@ -55,7 +55,7 @@ from seannet.data.split_graphs import SplitGraphs, flatten_lists, offsets_of, vi
 from seannet.data.view_inputs import ImageTransform, graph_from_columns, graph_tensors
 from seannet.errors import DataError
 from sgdata.dataset import Dataset, decode_image, observations_schema, read_table
-from sgdata.errors import DatasetError
+from sgdata.errors import DatasetError, one_line
 
 __all__ = [
     "ImageTransform",
@@ -91,7 +91,7 @@ def open_dataset(root: str | Path) -> Dataset:
     try:
         return Dataset.open(root)
     except DatasetError as exc:
-        raise DataError(_one_line(f"dataset {root}: {exc}")) from None
+        raise DataError(one_line(f"dataset {root}: {exc}")) from None
 
 
 def dataset_identity(root: str | Path | Dataset) -> dict[str, Any]:
@@ -121,10 +121,6 @@ def dataset_identity(root: str | Path | Dataset) -> dict[str, Any]:
     }
 
 
-def _one_line(text: str) -> str:
-    return " ".join(text.split())
-
-
 # ---------------------------------------------------------------------------------- storage
 
 
@@ -141,7 +137,7 @@ class _Shard:
         try:
             table = read_table(path, observations_schema(), columns=columns)
         except DatasetError as exc:
-            raise DataError(_one_line(str(exc))) from None
+            raise DataError(one_line(str(exc))) from None
         self.images = table.column("image") if with_images else None
         self.obj_offsets, obj = flatten_lists(
             table.column("objects"), ("instance", "class_id", "slot", "box2d")
@@ -382,7 +378,7 @@ def _call(fn: Any, *args: Any, **kwargs: Any) -> Any:
     try:
         return fn(*args, **kwargs)
     except DatasetError as exc:
-        raise DataError(_one_line(str(exc))) from None
+        raise DataError(one_line(str(exc))) from None
 
 
 def _indices(indices: Sequence[int]) -> np.ndarray:

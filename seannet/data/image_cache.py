@@ -31,7 +31,6 @@ import dataclasses
 import hashlib
 import json
 import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -43,7 +42,7 @@ from seannet.data.view_inputs import ImageTransform
 from seannet.errors import DataError
 from sgdata.dataset import Dataset, decode_image, observations_schema, read_table
 from sgdata.errors import DatasetError
-from sgdata.fileio import atomic_write_text
+from sgdata.fileio import atomic_file, atomic_write_text
 
 __all__ = [
     "CACHE_FORMAT",
@@ -234,39 +233,34 @@ def build_image_cache(
     try:
         files = ds.observation_files(split)
         counts = [_rows(p) for p in files]
-        directory.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(dir=directory, prefix=f".{split}.npy.", suffix=".tmp")
-        os.close(fd)
     except OSError as exc:
         raise DataError(f"image cache {directory}: cannot write ({exc.strerror or exc})") from None
     obs_ids: list[str] = []
     source_hw: list[list[int]] = []
     try:
-        shape = (sum(counts), s, s, 3)
-        out = np.lib.format.open_memmap(tmp, mode="w+", dtype=np.uint8, shape=shape)
-        at = 0
-        for path in files:
-            table = _read(path, ("obs_id", "image"))
-            ids = table.column("obs_id").to_pylist()
-            images = table.column("image")
-            for k, obs in enumerate(ids):
-                try:
-                    rgb = decode_image(images[k].as_py())
-                except DatasetError as exc:
-                    raise DataError(f"observation {obs!r}: {exc}") from None
-                source_hw.append([int(rgb.shape[0]), int(rgb.shape[1])])
-                out[at] = resize_like_transform(rgb, transform)
-                at += 1
-            obs_ids += ids
-        out.flush()
-        del out
-        # no moment where an old JSON vouches for the new array
-        (directory / f"{split}.json").unlink(missing_ok=True)
-        os.replace(tmp, directory / f"{split}.npy")
+        with atomic_file(directory / f"{split}.npy") as tmp:
+            shape = (sum(counts), s, s, 3)
+            out = np.lib.format.open_memmap(tmp, mode="w+", dtype=np.uint8, shape=shape)
+            at = 0
+            for path in files:
+                table = _read(path, ("obs_id", "image"))
+                ids = table.column("obs_id").to_pylist()
+                images = table.column("image")
+                for k, obs in enumerate(ids):
+                    try:
+                        rgb = decode_image(images[k].as_py())
+                    except DatasetError as exc:
+                        raise DataError(f"observation {obs!r}: {exc}") from None
+                    source_hw.append([int(rgb.shape[0]), int(rgb.shape[1])])
+                    out[at] = resize_like_transform(rgb, transform)
+                    at += 1
+                obs_ids += ids
+            out.flush()
+            del out
+            # no moment where an old JSON vouches for the new array
+            (directory / f"{split}.json").unlink(missing_ok=True)
     except OSError as exc:
         raise DataError(f"image cache {directory}: cannot write ({exc.strerror or exc})") from None
-    finally:
-        Path(tmp).unlink(missing_ok=True)
     meta = {**expected, "obs_ids": obs_ids, "source_hw": source_hw}
     try:  # the JSON goes last: it is what marks the array as fresh
         atomic_write_text(directory / f"{split}.json", json.dumps(meta, sort_keys=True) + "\n")

@@ -21,8 +21,7 @@ import numpy as np
 from seannet.data.box_noise import BoxNoise
 from seannet.evaluation.metrics import Embeddings
 from seannet.training.runs import BEST
-from sgdata.dataset.rows import sha256_file
-from sgdata.fileio import atomic_write_bytes
+from sgdata.fileio import atomic_write_bytes, sha256_file
 
 __all__ = ["CACHE_DIR", "cached_embeddings"]
 

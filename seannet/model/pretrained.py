@@ -17,7 +17,7 @@ from torch import Tensor, nn
 
 from seannet.errors import ModelError
 from seannet.weights import WEIGHTS
-from sgdata.dataset.rows import sha256_file
+from sgdata.fileio import sha256_file
 
 __all__ = [
     "check_pretrained_request",

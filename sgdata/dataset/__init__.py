@@ -48,7 +48,7 @@ _EXPORTS = {
     "ParquetInfo": ".rows",
     "encode_image": ".rows",
     "observation_table": ".rows",
-    "sha256_file": ".rows",
+    "sha256_file": "sgdata.fileio",
     "triplet_table": ".rows",
     "write_parquet": ".rows",
     "FORMAT_VERSION": ".schema",

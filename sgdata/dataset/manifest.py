@@ -22,10 +22,9 @@ from sgdata.annotate.relations import RelationType
 from sgdata.dataset.card import write_card
 from sgdata.dataset.croissant import write_croissant
 from sgdata.dataset.paths import CARD, CROISSANT, MANIFEST, SPLITS
-from sgdata.dataset.rows import sha256_file
 from sgdata.dataset.schema import FORMAT_VERSION, manifest_json_schema, migrate_manifest_dict
 from sgdata.errors import DatasetError
-from sgdata.fileio import atomic_write_text
+from sgdata.fileio import atomic_write_text, sha256_file
 
 __all__ = [
     "FORMAT_NAME",

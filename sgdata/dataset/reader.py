@@ -17,10 +17,10 @@ from PIL import Image
 
 from sgdata.dataset.manifest import Manifest, read_manifest
 from sgdata.dataset.paths import MANIFEST, observations_path, triplets_path
-from sgdata.dataset.rows import sha256_file
 from sgdata.dataset.schema import FORMAT_VERSION, observations_schema, since, triplets_schema
 from sgdata.dataset.storage import image_bytes, is_image_field, memory_column
 from sgdata.errors import DatasetError, one_line
+from sgdata.fileio import sha256_file
 
 __all__ = ["Dataset", "decode_image", "read_table"]
 

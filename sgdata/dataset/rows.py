@@ -9,10 +9,7 @@ manifest).
 
 from __future__ import annotations
 
-import hashlib
 import io
-import os
-import tempfile
 import zlib
 from collections.abc import Collection, Sequence
 from pathlib import Path
@@ -28,7 +25,10 @@ from sgdata.dataset.channels import encode_depth, encode_mask
 from sgdata.dataset.paths import SCENE_LAYER, obs_id
 from sgdata.dataset.schema import observations_schema, triplets_schema
 from sgdata.dataset.storage import file_table
+from sgdata.deprecation import moved_names
 from sgdata.errors import DatasetError
+from sgdata.fileio import atomic_file
+from sgdata.fileio import sha256_file as _sha256_file  # the bare name is the old one, below
 from sgdata.world.triplets import Triplet
 
 __all__ = [
@@ -40,7 +40,6 @@ __all__ = [
     "observation_table",
     "triplet_table",
     "write_parquet",
-    "sha256_file",
 ]
 
 IMAGE_FORMATS = ("png", "jpeg")
@@ -59,7 +58,6 @@ PARQUET_OPTIONS: dict[str, object] = {
     "write_statistics": True,
     "data_page_version": "2.0",
 }
-_HASH_CHUNK = 1 << 20
 
 
 class ParquetInfo(NamedTuple):
@@ -313,16 +311,6 @@ def triplet_table(triplets: Sequence[Triplet], obs_ids: Collection[str] | None =
     return pa.Table.from_arrays([columns[f.name] for f in schema], schema=schema)
 
 
-def sha256_file(path: Path) -> tuple[str, int]:
-    """(sha256 hex digest, size in bytes) of a file, read in chunks."""
-    digest, size = hashlib.sha256(), 0
-    with open(path, "rb") as handle:
-        while chunk := handle.read(_HASH_CHUNK):
-            digest.update(chunk)
-            size += len(chunk)
-    return digest.hexdigest(), size
-
-
 def write_parquet(table: pa.Table, path: Path) -> ParquetInfo:
     """Write ``table`` to ``path`` atomically with :data:`PARQUET_OPTIONS`.
 
@@ -338,22 +326,16 @@ def write_parquet(table: pa.Table, path: Path) -> ParquetInfo:
     """
     path = Path(path)
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp_name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    except OSError as exc:
-        raise DatasetError(f"{path}: cannot write here ({exc.strerror})") from None
-    tmp = Path(tmp_name)
-    try:
-        with os.fdopen(fd, "wb") as handle:
-            pq.write_table(file_table(table), handle, **PARQUET_OPTIONS)
-            handle.flush()
-            os.fsync(handle.fileno())
-        digest, size = sha256_file(tmp)
-        os.replace(tmp, path)
-    except (pa.ArrowException, OSError) as exc:
-        tmp.unlink(missing_ok=True)
+        with atomic_file(path) as tmp:
+            with open(tmp, "wb") as handle:
+                pq.write_table(file_table(table), handle, **PARQUET_OPTIONS)
+            digest, size = _sha256_file(tmp)
+    except pa.ArrowException as exc:
         raise DatasetError(f"{path}: cannot write the table as Parquet ({exc})") from None
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+    except OSError as exc:
+        raise DatasetError(f"{path}: cannot write here ({exc.strerror or exc})") from None
     return ParquetInfo(rows=table.num_rows, sha256=digest, bytes=size)
+
+
+# old names, served with a DeprecationWarning for one release
+__getattr__ = moved_names(__name__, {"sha256_file": "sgdata.fileio:sha256_file"})

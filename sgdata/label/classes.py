@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import difflib
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from sgdata.errors import ConfigError
+from sgdata.fileio import read_toml
 from sgdata.world.catalog import Catalog, load_catalog
 
 __all__ = ["ClassNames", "load_class_names"]
@@ -65,14 +65,7 @@ def load_class_names(class_map: Path | None = None, catalog: Catalog | None = No
     if class_map is None:
         return ClassNames(names, containers=containers)
     path = Path(class_map)
-    try:
-        raw = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ConfigError(f"{path}: class map not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"{path}: cannot read the class map ({exc})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{path}: not valid TOML ({exc})") from None
+    raw = read_toml(path, "class map")
     mapped = {}
     for name, target in raw.items():
         if not isinstance(target, str):

@@ -10,13 +10,13 @@ against ``--images``, and only then are the labels written to the label store
 from __future__ import annotations
 
 import re
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from pydantic import ValidationError
 
 from sgdata.errors import ConfigError, SgdataError
+from sgdata.fileio import read_toml
 from sgdata.label.annotations import AnnotationFormatError, ForeignPhoto
 from sgdata.label.classes import ClassNames, load_class_names
 from sgdata.label.export import ExportSummary
@@ -81,12 +81,7 @@ def load_import_map(path: Path | None) -> ImportMap:
     if path is None:
         return ImportMap(load_class_names(None))
     path = Path(path)
-    try:
-        raw = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ConfigError(f"{path}: class map not found") from None
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-        raise ConfigError(f"{path}: not a readable TOML class map ({exc})") from None
+    raw = read_toml(path, "class map")
     table = raw.get("relations")
     if table is None:
         return ImportMap(load_class_names(path))

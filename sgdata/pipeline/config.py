@@ -16,7 +16,6 @@ from __future__ import annotations
 import dataclasses
 import math
 import re
-import tomllib
 import types
 import typing
 from dataclasses import dataclass, field
@@ -27,6 +26,7 @@ from typing import Any, ClassVar
 from sgdata.annotate.relations import RelationRules
 from sgdata.dataset.paths import SPLITS
 from sgdata.errors import ConfigError, SgdataError
+from sgdata.fileio import parse_toml
 from sgdata.render.camera import CameraConfig
 from sgdata.world.appearance import AppearanceConfig
 from sgdata.world.catalog import Catalog, load_catalog
@@ -314,10 +314,7 @@ def load_config(source: str | Path) -> GenerateConfig:
             out-of-range value — naming the file and the key.
     """
     text, where = _read(source)
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{where}: not valid TOML ({exc})") from None
+    data = parse_toml(text, where)
     try:
         config = _build(GenerateConfig, data, "")
     except ConfigError as exc:

@@ -19,8 +19,8 @@ import dataclasses
 from collections.abc import Collection
 from pathlib import Path
 
-from sgdata.dataset.rows import sha256_file
 from sgdata.errors import ConfigError, SgdataError, UsdError
+from sgdata.fileio import sha256_file
 from sgdata.pipeline.config import ROOM_TYPE_NAME, GenerateConfig, RoomFile, RoomsConfig
 from sgdata.scene_files import SOURCE_FILE, room_file
 from sgdata.seeds import user_room_seed

@@ -34,7 +34,7 @@ _EXPORTS = {
     "open_stage": ".stage",
     "usd_reason": ".stage",
     "validate_stage": ".stage",
-    "write_text_atomic": ".stage",
+    "write_usd_file": ".stage",
     "DEFAULT_COLOR": ".geometry",
     "read_geometry": ".geometry",
     "stage_geometry": ".geometry",
@@ -81,5 +81,8 @@ _EXPORTS = {
     "write_flattened": ".tagging",
 }
 
+# old names, still served (with a DeprecationWarning from their module) for one release
+_DEPRECATED = {"write_text_atomic": ".stage"}
+
 __all__ = sorted(_EXPORTS)
-__getattr__, __dir__ = lazy_face(__name__, _EXPORTS)
+__getattr__, __dir__ = lazy_face(__name__, {**_EXPORTS, **_DEPRECATED})

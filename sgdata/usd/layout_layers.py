@@ -27,7 +27,7 @@ from sgdata.errors import SceneError, UsdError
 from sgdata.scene_files import ROOM_FILE
 from sgdata.usd.looks import RoomParts, define_layout_materials, override_light, override_look
 from sgdata.usd.prims import ROOT, object_path
-from sgdata.usd.stage import open_layer, write_text_atomic
+from sgdata.usd.stage import open_layer, write_usd_file
 from sgdata.usd.user_layouts import UserFrame, override_user
 from sgdata.world.appearance import LayoutAppearance
 from sgdata.world.scene import Room, SceneObject
@@ -111,7 +111,7 @@ def write_layout(
     if appearance is not None and parts is not None:
         define_layout_materials(layer, materials)
         override_light(layer, parts, appearance)
-    write_text_atomic(path, layer.ExportToString())
+    write_usd_file(path, layer.ExportToString())
 
 
 def _override(

@@ -37,7 +37,7 @@ from pxr import Gf, Kind, Sdf, Usd, UsdGeom, Vt
 
 from sgdata.errors import SceneError, UsdError
 from sgdata.usd.prims import OBJECTS, ROOT, STRUCTURE, object_path
-from sgdata.usd.stage import open_stage, write_text_atomic
+from sgdata.usd.stage import open_stage, write_usd_file
 from sgdata.world.scene import WALLS, Dynamics, Opening, Placement, Room, SceneObject
 
 if TYPE_CHECKING:
@@ -159,7 +159,7 @@ def write_room(
         _define_object(stage, obj, by_instance, geometry, dresser)
     if dresser is not None:
         dresser.finish()
-    write_text_atomic(path, stage.GetRootLayer().ExportToString())
+    write_usd_file(path, stage.GetRootLayer().ExportToString())
 
 
 def _define_object(

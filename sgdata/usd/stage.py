@@ -2,7 +2,7 @@
 
 Every stage of the project (generated rooms, layouts, user rooms and their tag layers) is read
 through :func:`open_stage` (one-line errors, sublayers checked) and written through
-:func:`write_text_atomic`; :func:`validate_stage` runs every validator registered in
+:func:`write_usd_file` (atomically); :func:`validate_stage` runs every validator registered in
 ``pxr.UsdValidation`` (usd-core no longer ships ``usdchecker``; this is its engine).
 """
 
@@ -13,21 +13,23 @@ from pathlib import Path
 
 from pxr import Sdf, Tf, Usd, UsdValidation
 
+from sgdata.deprecation import moved_names
 from sgdata.errors import UsdError, one_line
 from sgdata.fileio import atomic_write_text
 
 __all__ = [
     "open_layer",
     "open_stage",
-    "write_text_atomic",
+    "write_usd_file",
     "validate_stage",
     "check_stage",
     "usd_reason",
 ]
 
 
-def write_text_atomic(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` through a temporary file in the same folder and a rename.
+def write_usd_file(path: Path, text: str) -> None:
+    """Write a layer's ``text`` to ``path`` atomically (:func:`sgdata.fileio.atomic_file`) and
+    reload the copy of that layer this process holds, if any.
 
     Raises:
         UsdError: the folder cannot be created or the file cannot be written.
@@ -141,3 +143,7 @@ def usd_reason(exc: Tf.ErrorException) -> str:
     except UnicodeDecodeError:  # pxr quotes the bad bytes of a corrupted file
         return "its text is not valid UTF-8 where USD stopped reading"
     return (text.split(" : ", 1)[-1] if " : " in text else text).strip("' ")
+
+
+# old names, served with a DeprecationWarning for one release
+__getattr__ = moved_names(__name__, {"write_text_atomic": "sgdata.usd.stage:write_usd_file"})

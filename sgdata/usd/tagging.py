@@ -24,7 +24,7 @@ from sgdata.errors import ConfigError
 from sgdata.scene_files import ROOM_FILE
 from sgdata.usd.prims import ROOM_ORIGIN
 from sgdata.usd.room_io import read_room
-from sgdata.usd.stage import open_stage, validate_stage, write_text_atomic
+from sgdata.usd.stage import open_stage, validate_stage, write_usd_file
 from sgdata.usd.stage_frame import room_prim
 from sgdata.usd.user_rooms import MEASURED, measure_stage
 from sgdata.world.catalog import Catalog, load_catalog
@@ -113,7 +113,7 @@ def tag_stage(
         if alias is not None:  # the catalog class it stands for, over the user's name
             spec = _spec(layer, stage.GetPrimAtPath(key))
             _attr(spec, None, "sgdata:class", Sdf.ValueTypeNames.String, alias)
-    write_text_atomic(out, layer.ExportToString())
+    write_usd_file(out, layer.ExportToString())
     room = read_room(out)
     return TagReport(
         source=source,
@@ -138,7 +138,7 @@ def write_flattened(source: Path, output: Path, *, doc: str) -> None:
     """
     layer = open_stage(Path(source)).Flatten()
     layer.documentation = doc
-    write_text_atomic(Path(output), layer.ExportToString())
+    write_usd_file(Path(output), layer.ExportToString())
 
 
 def _relative(source: Path, folder: Path) -> str:

@@ -13,9 +13,9 @@ import pyarrow.parquet as pq
 
 from sgdata.dataset.manifest import Manifest
 from sgdata.dataset.paths import MANIFEST
-from sgdata.dataset.rows import sha256_file
 from sgdata.dataset.schema import check_compatible, manifest_json_schema
 from sgdata.errors import DatasetError, one_line
+from sgdata.fileio import sha256_file
 from sgdata.validate.problems import Collector
 
 __all__ = ["read_raw_manifest", "check_manifest", "check_files", "check_splits"]

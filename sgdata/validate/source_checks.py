@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from sgdata.dataset.paths import MANIFEST
-from sgdata.dataset.rows import sha256_file
+from sgdata.fileio import sha256_file
 from sgdata.validate.problems import Collector
 
 __all__ = ["catalog_asset_files", "check_sources", "user_room_files"]

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import glob
-import tomllib
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cache
@@ -12,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 from sgdata.errors import CatalogError
+from sgdata.fileio import read_toml
 from sgdata.world.scene import Dynamics
 
 __all__ = [
@@ -163,14 +163,7 @@ def load_catalog(path: str | Path | None = None, *, extra: Sequence[str | Path] 
 
 
 def _read_table(path: Path) -> dict[str, Any]:
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise CatalogError(f"{path}: catalog file not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise CatalogError(f"{path}: cannot read the catalog file ({exc})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise CatalogError(f"{path}: not valid TOML ({exc})") from None
+    data = read_toml(path, "catalog file", error=CatalogError)
     table = data.get("classes")
     if not isinstance(table, dict) or not table:
         raise CatalogError(f"{path}: expected a [classes.<Name>] table per object class")

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import tomllib
 from dataclasses import dataclass
 from functools import cache
 from importlib import resources
@@ -10,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from sgdata.errors import CatalogError
+from sgdata.fileio import read_toml
 from sgdata.world.catalog import Catalog
 
 __all__ = ["ROOM_TYPES", "CountedClass", "RoomRecipe", "load_room_recipes"]
@@ -62,12 +62,7 @@ def _default_path() -> Path:
 
 @cache
 def _load(path: str, catalog: Catalog) -> dict[str, RoomRecipe]:
-    try:
-        data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise CatalogError(f"{path}: room recipe file not found") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise CatalogError(f"{path}: not valid TOML ({exc})") from None
+    data = read_toml(Path(path), "room recipe file", error=CatalogError)
     table = data.get("room_types", {})
     missing = [t for t in ROOM_TYPES if t not in table]
     if missing:

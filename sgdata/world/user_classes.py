@@ -15,11 +15,11 @@ placement rules and GCN slots) -- what ``sgdata generate`` needs for a dataset::
 
 from __future__ import annotations
 
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from sgdata.errors import ConfigError
+from sgdata.fileio import read_toml
 from sgdata.world.catalog import Catalog, load_catalog
 from sgdata.world.scene import Dynamics
 
@@ -49,14 +49,7 @@ def read_class_file(path: Path | None, catalog: Catalog | None = None) -> UserCl
     if path is None:
         return UserClasses()
     path = Path(path)
-    try:
-        raw = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ConfigError(f"{path}: class file not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"{path}: cannot read the class file ({exc})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{path}: not valid TOML ({exc})") from None
+    raw = read_toml(path, "class file")
     table = raw.get("classes", raw) if isinstance(raw.get("classes"), dict) else raw
     dynamics: dict[str, Dynamics] = {}
     aliases: dict[str, str] = {}

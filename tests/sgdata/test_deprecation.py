@@ -14,6 +14,8 @@ MOVED = [
     ("sgdata.usd.own_layouts", "own_frame", "sgdata.usd.user_layouts", "user_frame"),
     ("sgdata.usd.own_layouts", "override_own", "sgdata.usd.user_layouts", "override_user"),
     ("sgdata.seeds", "own_room_seed", "sgdata.seeds", "user_room_seed"),
+    ("sgdata.dataset.rows", "sha256_file", "sgdata.fileio", "sha256_file"),
+    ("sgdata.usd.stage", "write_text_atomic", "sgdata.usd.stage", "write_usd_file"),
 ]
 
 
