@@ -9,13 +9,17 @@
     python bench/navigation.py epsilon DATA OUT --localizer RUN [...] [--val-episodes 10]
     python bench/navigation.py tables [OUT] [-o docs/navigation.md]
 
-``run`` records what made the runs (commit, command, dataset manifest sha256 and format
-version) in ``OUT/provenance.json``, trains the navigator into ``OUT/navigator`` (pairs cached
-in ``OUT/navigator_pairs``; skipped once trained) and runs ``seannet navigate`` of every
-localizer on the test rooms under the paper's rule and ``--replan`` into ``OUT/navigate``
+``run`` appends what made the runs (commit at process start, command, dataset manifest
+sha256 and format version) to ``OUT/provenance.jsonl`` (:mod:`seannet.provenance`; the
+tables' stamp names every such call), trains the navigator into ``OUT/navigator`` (pairs
+cached in ``OUT/navigator_pairs``; skipped once trained) and runs ``seannet navigate`` of
+every localizer on the test rooms under the paper's rule and ``--replan`` into ``OUT/navigate``
 (it resumes where a killed run stopped). ``--full-maps`` derives each localizer's maps from
 its spacing-1 maps instead of rendering them; ``--val-epsilon`` runs again with the stop
 thresholds that ``epsilon`` chose on the val rooms, into ``OUT/navigate-val-epsilon``.
+
+``epsilon`` chooses each localizer's stop threshold on the val rooms
+(:mod:`seannet.navigation.stop_threshold`) into ``OUT/epsilon.json``.
 
 ``variants`` chooses the navigator on val before ``run``: each variant (fusion, ImageNet init,
 light jitter) is trained on the same subset of ``run``'s cached train pairs (``--subset``
@@ -39,20 +43,21 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "bench"))
-
-from results import provenance  # noqa: E402  (bench/results.py: one home for provenance)
 
 import seannet  # noqa: E402,F401  (imports torch's compiler stack first: see tests/conftest.py)
 from seannet.data.datasets import dataset_identity  # noqa: E402
 from seannet.data.live_views import LiveRooms  # noqa: E402
-from seannet.navigation.benchmark import run_labels, run_navigation  # noqa: E402
-from seannet.navigation.episodes import CASES  # noqa: E402
-from seannet.navigation.localizer import run_epsilon  # noqa: E402
-from seannet.navigation.maps import MAP_META, derive_map, load_map, save_map  # noqa: E402
-from seannet.navigation.navigator import NavigatorConfig  # noqa: E402
+from seannet.markdown import table  # noqa: E402
+from seannet.navigation.benchmark import results_path, run_navigation, seed_maps  # noqa: E402
+from seannet.navigation.config import FUSIONS, NavigationTestConfig, NavigatorConfig  # noqa: E402
 from seannet.navigation.navigator_training import fit_navigator, train_navigator  # noqa: E402
 from seannet.navigation.pairs import PairSet, render_pairs  # noqa: E402
+from seannet.navigation.stop_threshold import (  # noqa: E402
+    EPSILON_OFFSETS,
+    VAL_EPISODES,
+    VAL_EPSILON,
+    choose_epsilon,
+)
 from seannet.navigation.tables import (  # noqa: E402
     RATE_HEADER,
     SPLIT_HEADER,
@@ -61,21 +66,24 @@ from seannet.navigation.tables import (  # noqa: E402
     read_results,
     time_rows,
 )
+from seannet.provenance import (  # noqa: E402
+    append_provenance,
+    provenance_record,
+    read_provenance,
+    stamp,
+)
 from seannet.training.runs import BEST, HISTORY, load_checkpoint  # noqa: E402
 from seannet.weights import LITE0_WEIGHTS  # noqa: E402
 from sgdata.dataset import Dataset  # noqa: E402
 from sgdata.fileio import atomic_write_text  # noqa: E402
 
-SPLIT = "test"
-PROVENANCE = "provenance.json"
-MAP_SPACING = 2  # the maps `navigate` builds (its default, the authors' spacing)
+# docs/navigation.md's runs: the test's defaults, the navigator's with more pairs than the CLI's
+TEST = NavigationTestConfig(replan=True)
+NAVIGATOR = NavigatorConfig(train_pairs=20_000, val_pairs=2_000)
+RUN_STEP = "run"  # provenance records of `run` (with VAL_SUFFIX: of `run --val-epsilon`)
 NO_FULL_MAPS = "-"  # --full-maps of a localizer whose maps are to be built
 VARIANTS = "variants.json"
 EPSILON = "epsilon.json"
-# the stop thresholds tried on val rooms per localizer, offsets from its eval epsilon (chosen
-# for telling same-pose pairs apart, not for stopping on a sub-goal in another layout)
-EPSILON_OFFSETS = (0.0, -0.05, -0.10, -0.15, -0.20)
-VAL_EPSILON = "navigation on val"  # the source the tables print beside such an epsilon
 VAL_SUFFIX = "-val-epsilon"  # navigate, strips and provenance of the run with those
 # navigator variants compared on val (name: config changes, ImageNet init)
 NAVIGATOR_VARIANTS = {
@@ -116,13 +124,18 @@ def run(args: argparse.Namespace) -> None:
     out: Path = args.out
     out.mkdir(parents=True, exist_ok=True)
     suffix = VAL_SUFFIX if args.val_epsilon else ""
-    record = json.dumps(provenance(args.data, sys.argv), indent=2)
-    atomic_write_text(out / PROVENANCE.replace(".json", f"{suffix}.json"), record)
+    append_provenance(out, args.data, step=RUN_STEP + suffix)
     config = navigator_config(args)
     if args.full_maps:
         if len(args.full_maps) != len(args.localizer):
             raise SystemExit("give one --full-maps per --localizer, in the same order")
-        seed_maps(args.localizer, args.full_maps, args.data, out / "navigate" / "maps")
+        given = {
+            run: source
+            for run, source in zip(args.localizer, args.full_maps, strict=True)
+            if str(source) != NO_FULL_MAPS
+        }
+        rooms = list(Dataset.open(args.data).rooms(TEST.split))
+        seed_maps(args.localizer, given, rooms, out / "navigate" / "maps", spacing=TEST.spacing)
     navigator = out / "navigator"
     if not (navigator / BEST).is_file():
         cache = out / "navigator_pairs"
@@ -135,10 +148,8 @@ def run(args: argparse.Namespace) -> None:
         args.localizer,
         navigator,
         args.data,
-        split=SPLIT,
-        episodes=args.episodes,
+        TEST.replace(episodes=args.episodes),
         epsilon=epsilon,
-        replan=True,
         workers=args.workers,
         out=out / f"navigate{suffix}",
         maps=out / "navigate" / "maps",  # maps do not depend on epsilon
@@ -147,66 +158,21 @@ def run(args: argparse.Namespace) -> None:
     )
 
 
-def choose_epsilon(args: argparse.Namespace) -> None:
-    """Per localizer, the stop threshold of :data:`EPSILON_OFFSETS` with the best mean success
-    (N and A, the paper's rule) on the val rooms; ``OUT/epsilon.json``."""
+def epsilon_verb(args: argparse.Namespace) -> None:
+    """Each localizer's stop threshold chosen on the val rooms
+    (:func:`seannet.navigation.stop_threshold.choose_epsilon`); ``OUT/epsilon.json``."""
     out: Path = args.out
-    rows = []
-    for run, label in zip(args.localizer, run_labels(args.localizer), strict=True):
-        found = run_epsilon(run)
-        if found is None:
-            raise SystemExit(f"{run}: no evaluated epsilon; run `seannet eval` on val first")
-        base, source = found
-        grid = []
-        for offset in EPSILON_OFFSETS:
-            epsilon = round(base + offset, 4)
-            results = run_navigation(
-                [run],
-                out / "navigator",
-                args.data,
-                split="val",
-                episodes=args.val_episodes,
-                epsilon=epsilon,
-                workers=args.workers,
-                out=out / "epsilon" / label / f"{epsilon:.4f}",
-                maps=out / "epsilon" / "maps" / label,
-            )
-            episodes = results["runs"][0]["episodes"]
-            success = {
-                case: float(
-                    np.mean(
-                        [e["paper"]["outcome"] == "success" for e in episodes if e["case"] == case]
-                    )
-                )
-                for case in CASES
-            }
-            grid.append({"epsilon": epsilon, "offset": offset, "success": success})
-            print(f"{label} epsilon {epsilon:.3f}: success {success}", flush=True)
-        best = max(grid, key=lambda g: sum(g["success"].values()))  # the first of equals
-        rows.append({"run": str(run), "label": label, "eval_epsilon": base,
-                     "eval_source": source, "grid": grid, "chosen": best["epsilon"]})  # fmt: skip
-    record = {
-        "provenance": provenance(args.data, sys.argv),
-        "split": "val",
-        "episodes_per_case_and_room": args.val_episodes,
-        "localizers": rows,
-    }
+    record = choose_epsilon(
+        args.localizer,
+        out / "navigator",
+        args.data,
+        out / "epsilon",
+        NavigationTestConfig(split="val", episodes=args.val_episodes),
+        workers=args.workers,
+        progress=lambda text: print(text, flush=True),
+    )
+    record = {"provenance": provenance_record(args.data, step="epsilon"), **record}
     atomic_write_text(out / EPSILON, json.dumps(record, indent=2))
-
-
-def seed_maps(localizers: list[Path], full_maps: list[Path], data: Path, maps: Path) -> None:
-    """Put into the navigation's map cache, for each localizer and test room, the map that
-    ``navigate`` would build, derived from that localizer's spacing-1 map (e.g. the full-map
-    recall's, bench/results.py): the same views and embeddings, not rendered again. A derived
-    map of another checkpoint is found stale by ``navigate`` and built anew."""
-    rooms = Dataset.open(data).rooms(SPLIT)
-    for label, source in zip(run_labels(localizers), full_maps, strict=True):
-        if str(source) == NO_FULL_MAPS:
-            continue
-        for room_id in rooms:
-            target = maps / label / room_id
-            if not (target / MAP_META).is_file() and (source / room_id / MAP_META).is_file():
-                save_map(derive_map(load_map(source / room_id), MAP_SPACING), target)
 
 
 def variants(args: argparse.Namespace) -> None:
@@ -243,7 +209,7 @@ def variants(args: argparse.Namespace) -> None:
         )
         print(f"{name}: val {100 * best['val_accuracy']:.1f} %", flush=True)
     record = {
-        "provenance": provenance(args.data, sys.argv),
+        "provenance": provenance_record(args.data, step="variants"),
         "train_pairs": len(subset),
         "val_pairs": len(val_set),
         "epochs": args.variant_epochs,
@@ -273,22 +239,14 @@ def variants_block(out: Path) -> str:
     header = ["navigator", "val acc %", *(f"{a} %" for a in actions), "best epoch", "s / epoch"]
     return "\n".join(
         [
-            f"Made {made['started']} by commit `{made['commit'][:12]}` on `{made['data']}` "
-            f"(manifest sha256 `{made['manifest_sha256'][:16]}`): `{made['command']}`. Each "
-            f"variant trained on the same {record['train_pairs']:,} train pairs for "
+            stamp([made]),
+            "",
+            f"Each variant trained on the same {record['train_pairs']:,} train pairs for "
             f"{record['epochs']} epochs, scored on {record['val_pairs']:,} val pairs.",
             "",
-            *_table(header, rows),
+            *table(header, rows),
         ]
     )
-
-
-def _table(header: list[str], rows: list[list[str]]) -> list[str]:
-    return [
-        "| " + " | ".join(header) + " |",
-        "|" + "---|" * len(header),
-        *("| " + " | ".join(r) + " |" for r in rows),
-    ]
 
 
 def paper_rows() -> list[list[str]]:
@@ -302,18 +260,15 @@ def paper_rows() -> list[list[str]]:
 
 def measured_block(out: Path, suffix: str = "") -> str:
     """The tables of ``out``'s runs (``navigate{suffix}``), stamped with what made them."""
-    made = json.loads((out / PROVENANCE.replace(".json", f"{suffix}.json")).read_text())
-    results = read_results(out / f"navigate{suffix}" / f"navigate_{SPLIT}.json")
+    made = read_provenance(out, RUN_STEP + suffix, legacy=f"provenance{suffix}.json")
+    results = read_results(results_path(out / f"navigate{suffix}", TEST.split))
     history = json.loads((out / "navigator" / HISTORY).read_text())
     state = load_checkpoint(out / "navigator" / BEST)
     config = state["config"]
     init = f"ImageNet init {state['pretrained']}" if state.get("pretrained") else "random init"
     best = max(history, key=lambda h: h["val_accuracy"])
-    dirty = " with uncommitted changes" if made["dirty"] else ""
     lines = [
-        f"Made {made['started']} by commit `{made['commit'][:12]}`{dirty} on `{made['data']}` "
-        f"(manifest sha256 `{made['manifest_sha256'][:16]}`, format {made['format_version']}): "
-        f"`{made['command']}`.",
+        stamp(made),
         "",
         f"Navigator: {best['train_pairs']:,} train pairs at {config['image_size']} px, "
         f"{config['encoder']} ({init}, {config.get('fusion', 'late')} fusion), goals of "
@@ -334,25 +289,25 @@ def measured_block(out: Path, suffix: str = "") -> str:
         "",
         "The paper's rule (a collision ends the episode), beside the paper's Table II:",
         "",
-        *_table(RATE_HEADER, paper_rows() + rate_rows(results, "paper")),
+        *table(RATE_HEADER, paper_rows() + rate_rows(results, "paper")),
         "",
-        *_table(SPLIT_HEADER, rate_rows(results, "paper", split=True)),
+        *table(SPLIT_HEADER, rate_rows(results, "paper", split=True)),
     ]
     if results.get("replan"):
         lines += [
             "",
             "Bump and replan (beyond the paper):",
             "",
-            *_table(RATE_HEADER, rate_rows(results, "replan")),
+            *table(RATE_HEADER, rate_rows(results, "replan")),
             "",
-            *_table(SPLIT_HEADER, rate_rows(results, "replan", split=True)),
+            *table(SPLIT_HEADER, rate_rows(results, "replan", split=True)),
         ]
-    lines += ["", "Time per episode:", "", *_table(TIME_HEADER, time_rows(results))]
+    lines += ["", "Time per episode:", "", *table(TIME_HEADER, time_rows(results))]
     eps = [
         [f"{r['model']} ({r['label']})", f"{r['epsilon']:.3f}", r["epsilon_source"]]
         for r in results["runs"]
     ]
-    lines += ["", *_table(["localizer", "epsilon", "from"], eps)]
+    lines += ["", *table(["localizer", "epsilon", "from"], eps)]
     return "\n".join(lines)
 
 
@@ -360,7 +315,6 @@ def epsilon_block(out: Path) -> str:
     """The stop thresholds tried on val rooms (``OUT/epsilon.json``), then the test with the
     chosen ones."""
     record = json.loads((out / EPSILON).read_text())
-    made = record["provenance"]
     header = ["localizer", *(f"{o:+.2f}" for o in EPSILON_OFFSETS), "chosen"]
     rows = []
     for loc in record["localizers"]:
@@ -370,15 +324,15 @@ def epsilon_block(out: Path) -> str:
         ]
         rows.append([loc["label"], *cells, f"{loc['chosen']:.3f}"])
     lines = [
-        f"Made {made['started']} by commit `{made['commit'][:12]}` on `{made['data']}` "
-        f"(manifest sha256 `{made['manifest_sha256'][:16]}`): `{made['command']}`. "
+        stamp([record["provenance"]]),
+        "",
         f"{record['episodes_per_case_and_room']} episodes per case and room on the "
         f"{record['split']} rooms, paper rule; each cell: epsilon: success % N / A. Columns: "
         "offsets from the localizer's eval epsilon; chosen: the best mean of N and A.",
         "",
-        *_table(header, rows),
+        *table(header, rows),
     ]
-    if (out / f"navigate{VAL_SUFFIX}" / f"navigate_{SPLIT}.json").is_file():
+    if results_path(out / f"navigate{VAL_SUFFIX}", TEST.split).is_file():
         lines += ["", "The test rooms with the chosen thresholds:", ""]
         lines.append(measured_block(out, VAL_SUFFIX))
     return "\n".join(lines)
@@ -400,7 +354,7 @@ def replace_block(text: str, name: str, body: str) -> str:
 def write_tables(out: Path | None, doc: Path) -> None:
     """Rewrite ``doc``'s ``paper`` block, and its ``measured`` (and ``variants``, where they
     were compared) blocks from ``out`` if given."""
-    text = replace_block(doc.read_text(), "paper", "\n".join(_table(RATE_HEADER, paper_rows())))
+    text = replace_block(doc.read_text(), "paper", "\n".join(table(RATE_HEADER, paper_rows())))
     if out is not None:
         text = replace_block(text, "measured", measured_block(out))
         if (out / VARIANTS).is_file():
@@ -414,10 +368,10 @@ def _pair_options(parser: argparse.ArgumentParser) -> None:
     """What the rendered pairs depend on: the same for ``run`` and ``variants``."""
     parser.add_argument("data", type=Path)
     parser.add_argument("out", type=Path)
-    parser.add_argument("--pairs", type=int, default=20000)
-    parser.add_argument("--val-pairs", type=int, default=2000)
-    parser.add_argument("--image-size", type=int, default=96)
-    parser.add_argument("--cross-layout", type=float, default=0.0)
+    parser.add_argument("--pairs", type=int, default=NAVIGATOR.train_pairs)
+    parser.add_argument("--val-pairs", type=int, default=NAVIGATOR.val_pairs)
+    parser.add_argument("--image-size", type=int, default=NAVIGATOR.image_size)
+    parser.add_argument("--cross-layout", type=float, default=NAVIGATOR.cross_layout)
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -429,17 +383,17 @@ def main(argv: list[str] | None = None) -> None:
     stop.add_argument("data", type=Path)
     stop.add_argument("out", type=Path)
     stop.add_argument("--localizer", type=Path, action="append", required=True)
-    stop.add_argument("--val-episodes", type=int, default=10)
+    stop.add_argument("--val-episodes", type=int, default=VAL_EPISODES)
     stop.add_argument("--workers", type=int, default=2)
     for verb in (go, choose):
         _pair_options(verb)
     go.add_argument("--localizer", type=Path, action="append", required=True)
-    go.add_argument("--epochs", type=int, default=10)
-    go.add_argument("--encoder", default="resnet18")
+    go.add_argument("--epochs", type=int, default=NAVIGATOR.epochs)
+    go.add_argument("--encoder", default=NAVIGATOR.encoder)
     go.add_argument("--pretrained", type=Path, help="ImageNet init, e.g. imagenet-lite0")
-    go.add_argument("--jitter", type=float, default=0.0)
-    go.add_argument("--fusion", choices=("early", "late"), default="early")
-    go.add_argument("--episodes", type=int, default=20)
+    go.add_argument("--jitter", type=float, default=NAVIGATOR.jitter)
+    go.add_argument("--fusion", choices=FUSIONS, default=NAVIGATOR.fusion)
+    go.add_argument("--episodes", type=int, default=TEST.episodes)
     go.add_argument("--workers", type=int, default=2)
     go.add_argument(
         "--val-epsilon",
@@ -455,7 +409,9 @@ def main(argv: list[str] | None = None) -> None:
     )
     choose.add_argument("--subset", type=int, default=4800, help="train pairs per variant")
     choose.add_argument("--variant-epochs", type=int, default=3)
-    choose.set_defaults(epochs=1, encoder="resnet18", jitter=0.0, fusion="early")
+    choose.set_defaults(
+        epochs=1, encoder=NAVIGATOR.encoder, jitter=NAVIGATOR.jitter, fusion=NAVIGATOR.fusion
+    )
     tables = sub.add_parser("tables", help="write docs/navigation.md's tables")
     tables.add_argument("out", type=Path, nargs="?")
     tables.add_argument("-o", "--output", type=Path, default=ROOT / "docs" / "navigation.md")
@@ -465,7 +421,7 @@ def main(argv: list[str] | None = None) -> None:
     elif args.verb == "variants":
         variants(args)
     elif args.verb == "epsilon":
-        choose_epsilon(args)
+        epsilon_verb(args)
     else:
         write_tables(args.out, args.output)
 

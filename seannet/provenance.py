@@ -124,12 +124,16 @@ def append_provenance(
     return record
 
 
-def read_provenance(directory: Path, step: str | None = None) -> list[dict[str, Any]]:
-    """Every record of ``directory`` (of ``step`` when given), oldest first: the legacy
-    ``provenance.json`` / ``provenance-<step>.json`` first, then ``provenance.jsonl``'s lines
-    (a torn last line, from a killed process, is skipped)."""
-    legacy = directory / ("provenance.json" if step is None else f"provenance-{step}.json")
-    records = [json.loads(legacy.read_text()) | {"step": step}] if legacy.is_file() else []
+def read_provenance(
+    directory: Path, step: str | None = None, *, legacy: str | None = None
+) -> list[dict[str, Any]]:
+    """Every record of ``directory`` (of ``step`` when given), oldest first: the one record of
+    a directory written before 2026-12-03 (``legacy``, by default ``provenance.json`` or
+    ``provenance-<step>.json``) first, then ``provenance.jsonl``'s lines (a torn last line,
+    from a killed process, is skipped)."""
+    legacy = legacy or ("provenance.json" if step is None else f"provenance-{step}.json")
+    old = directory / legacy
+    records = [json.loads(old.read_text()) | {"step": step}] if old.is_file() else []
     path = directory / PROVENANCE
     if path.is_file():
         for line in path.read_text(encoding="utf-8").splitlines():

@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from seannet.errors import NavigationError
+from seannet.markdown import table
 from seannet.navigation.config import RULES
 from seannet.navigation.episodes import CASES, CAUSES, LOCALIZATION_KINDS, OUTCOMES
 from sgdata.fileio import atomic_write_text
@@ -127,14 +128,6 @@ def time_rows(results: dict[str, Any]) -> list[list[str]]:
     return rows
 
 
-def _table(header: list[str], rows: list[list[str]]) -> list[str]:
-    return [
-        "| " + " | ".join(header) + " |",
-        "|" + "---|" * len(header),
-        *("| " + " | ".join(r) + " |" for r in rows),
-    ]
-
-
 def markdown(results: dict[str, Any]) -> str:
     """``navigate_<split>.md``: the paper-rule table, its failure split, the ``--replan``
     table when run, time per episode, each run's epsilon."""
@@ -152,9 +145,9 @@ def markdown(results: dict[str, Any]) -> str:
         "replan": "Bump and replan (beyond the paper)",
     }
     for rule in rules:
-        lines += ["", f"## {titles[rule]}", "", *_table(RATE_HEADER, rate_rows(results, rule))]
-        lines += ["", *_table(SPLIT_HEADER, rate_rows(results, rule, split=True))]
-    lines += ["", "## Time per episode", "", *_table(TIME_HEADER, time_rows(results))]
+        lines += ["", f"## {titles[rule]}", "", *table(RATE_HEADER, rate_rows(results, rule))]
+        lines += ["", *table(SPLIT_HEADER, rate_rows(results, rule, split=True))]
+    lines += ["", "## Time per episode", "", *table(TIME_HEADER, time_rows(results))]
     lines += [
         "",
         "| localizer | epsilon | from |",

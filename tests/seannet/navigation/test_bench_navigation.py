@@ -9,6 +9,8 @@ from types import ModuleType, SimpleNamespace
 
 import pytest
 
+from seannet.provenance import append_provenance, read_provenance
+
 from ...bench_scripts import load_bench
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -38,15 +40,18 @@ def test_tables_from_tiny_runs(
     (out / "navigate").mkdir()
     for name in ("navigate_test.json", "navigate_test_times.json"):
         shutil.copy(navigation_run.out / name, out / "navigate")
-    made = bench.provenance(mini_dataset, ["bench/navigation.py", "run", "tiny"])
-    (out / bench.PROVENANCE).write_text(json.dumps(made))
+    # two `run` calls into the same OUT: the stamp names both
+    first = append_provenance(out, mini_dataset, step=bench.RUN_STEP)
+    made = append_provenance(out, mini_dataset, step=bench.RUN_STEP)
+    assert len(read_provenance(out, bench.RUN_STEP)) == 2
     doc = tmp_path / "navigation.md"
     doc.write_text(DOC)
     bench.write_tables(out, doc)
     text = doc.read_text()
     assert "typed by hand" not in text and "prose that stays" in text
     assert "| paper, SeanNet | 5,476 / 204,136 | 80.2 / 65.2 | 2.4 / 6.2 | 13.2 / 21.7 |" in text
-    assert made["commit"][:12] in text and made["manifest_sha256"][:16] in text
+    assert made["commit"][:10] in text and made["manifest_sha256"][:16] in text
+    assert "Made by 2 runs" in text and text.count(first["started"]) >= 1
     results = navigation_run.results
     (run,) = results["runs"]
     label = f"| {run['model']} ({run['label']}) | 2 / 2 |"
