@@ -7,10 +7,14 @@ from typing import Annotated
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.table import Table
 from sgdata_cli.errors import run_app
 
+from seannet.model.config import BACKBONES
+from seannet.model.specs import MODEL_NAMES, spec_help
 from seannet.navigation.config import FUSIONS, MAP_SPACING, NavigationTestConfig, NavigatorConfig
+from seannet.training.config import PRESETS
 from sgdata.errors import SgdataError
 
 app = typer.Typer(
@@ -34,14 +38,11 @@ def train(
     out: Annotated[Path, typer.Option("--out", help="Run directory for checkpoints.")],
     model: Annotated[
         str,
-        typer.Option(
-            help="seannet (or an ablation: seannet-graph, ...) | resnet18 | resnet50 | resnext50 "
-            "| vgg16 | googlenet | efficientnet_lite0"
-        ),
+        typer.Option(help=f"One of {', '.join(MODEL_NAMES)}."),
     ] = "seannet",
-    preset: Annotated[str, typer.Option(help="cpu | gpu | paper")] = "cpu",
+    preset: Annotated[str, typer.Option(help=f"One of {', '.join(PRESETS)}.")] = "cpu",
     backbone: Annotated[
-        str | None, typer.Option(help="SeanNet's image network: resnet | efficientnet_lite0.")
+        str | None, typer.Option(help=f"SeanNet's image network: {' | '.join(BACKBONES)}.")
     ] = None,
     epochs: Annotated[int, typer.Option(help="Override the preset's epochs (0 keeps it).")] = 0,
     resume: Annotated[bool, typer.Option(help="Continue the run in --out.")] = False,
@@ -130,7 +131,7 @@ def evaluate(
     optionally with the box overlap (--boxes) or the learned box kernel (--box-kernel), or
     under labeler / detector box noise."""
     from seannet.data.box_noise import BoxNoise
-    from seannet.evaluation.eval import eval_file, evaluate_run
+    from seannet.evaluation.run_eval import eval_file, evaluate_run
 
     if boxes and box_kernel:
         raise typer.BadParameter("give --boxes or --box-kernel, not both")
@@ -149,11 +150,11 @@ def compare(
     models: Annotated[
         str,
         typer.Option(
-            help="Comma-separated specs NAME[@lite0][+imagenet][+boxes|+box-kernel]: seannet, "
-            "seannet-graph, resnet18, resnet18+boxes, seannet+box-kernel, seannet@lite0+imagenet"
+            help=f"Comma-separated model specs; {escape(spec_help())}. E.g. resnet18+boxes, "
+            "seannet@lite0+imagenet"
         ),
     ] = "seannet,resnet18",
-    preset: Annotated[str, typer.Option(help="cpu | gpu | paper")] = "cpu",
+    preset: Annotated[str, typer.Option(help=f"One of {', '.join(PRESETS)}.")] = "cpu",
     seeds: Annotated[str, typer.Option(help="Comma-separated training seeds.")] = "0",
     lrs: Annotated[
         str,
@@ -212,6 +213,14 @@ def wordvectors(
 
     write_word_vectors(output, source=source)
     console.print(f"wrote {output}")
+
+
+@app.command()
+def networks() -> None:
+    """The registry of image networks (markdown): widths, family, offline ImageNet weights."""
+    from seannet.weights import network_table
+
+    typer.echo(network_table(), nl=False)
 
 
 Run = Annotated[Path, typer.Argument(help="Localizer run directory (holds best.pt).")]

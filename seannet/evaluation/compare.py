@@ -17,10 +17,11 @@ The protocol (DESIGN §12), in the order it runs:
    t-interval; for the first model minus each other, the paired two-level bootstrap and
    Welch's seed-level interval (:mod:`seannet.evaluation.intervals`).
 
-A model is named by a spec ``NAME[@lite0][+imagenet][+boxes|+box-kernel]``: ``NAME`` a model
-or ablation (``seannet``, ``seannet-graph``, ``resnet18``, ``efficientnet_lite0``, ...),
-``@lite0`` puts SeanNet on the EfficientNet-Lite0 image network, ``+imagenet`` starts that
-network from the ImageNet weights that install offline (the `lite` extra), ``+boxes`` adds the
+A model is named by a spec ``NAME[@net][+imagenet][+boxes|+box-kernel]``
+(:mod:`seannet.model.specs`): ``NAME`` a model or ablation (``seannet``, ``seannet-graph``,
+``resnet18``, ``efficientnet_lite0``, ...), ``@net`` puts SeanNet on another image network of
+the registry (``@lite0``, ``@resnet18``), ``+imagenet`` starts that network from the ImageNet
+weights that install offline (the `lite` extra), ``+boxes`` adds the
 hand-made box overlap to the similarity (:mod:`seannet.evaluation.box_overlap`) and
 ``+box-kernel`` the box kernel learned on train (:mod:`seannet.evaluation.box_kernel`); their
 runs are ``NAME``'s: ``resnet18``, ``resnet18+boxes`` and ``resnet18+box-kernel`` train once.
@@ -43,7 +44,6 @@ from torch.utils.data import DataLoader
 
 from seannet.data.datasets import ImageTransform, TripletDataset, collate_triplets
 from seannet.errors import ModelError
-from seannet.evaluation.eval import evaluate_run, scene_term
 from seannet.evaluation.intervals import (
     per_room_matrix,
     t_interval,
@@ -51,13 +51,14 @@ from seannet.evaluation.intervals import (
     two_level_interval,
     welch_difference,
 )
+from seannet.evaluation.run_eval import evaluate_run
 from seannet.model.loss import TripletLoss
+from seannet.model.specs import parse_spec
 from seannet.training.config import TrainConfig
 from seannet.training.config import preset as load_preset
 from seannet.training.loop import train_one_epoch, triplet_step
 from seannet.training.runs import LAST, build_for_dataset, device_for_run
 from seannet.training.train import param_groups, train
-from seannet.weights import LITE0, LITE0_WEIGHTS
 from sgdata.dataset import Dataset
 from sgdata.fileio import atomic_write_text
 
@@ -75,7 +76,6 @@ __all__ = [
 COMPARISON = "comparison"  # comparison.json and comparison.md under the output directory
 SELECTION = "selection.json"  # every choice, written before any test row is read
 _CALIBRATION_STEPS = 3  # timed training steps (after one warm-up) per model
-_IMAGENET = "+imagenet"
 
 
 @dataclass(frozen=True)
@@ -86,32 +86,21 @@ class ModelSpec:
     trained: str  # the trained network's spec (its run directory), e.g. "resnet18"
     config: TrainConfig
     pretrained: Path | None
-    boxes: str  # the scene term added to the similarity (eval.SCENE_TERMS), or ""
+    boxes: str  # the scene term added to the similarity (specs.SCENE_TERMS), or ""
 
 
 def model_spec(spec: str, base: TrainConfig) -> ModelSpec:
-    """What a spec ``NAME[@lite0][+imagenet][+boxes|+box-kernel]`` names.
+    """What a spec ``NAME[@net][+imagenet][+boxes|+box-kernel]`` names, parsed against the
+    registry of networks (:func:`seannet.model.specs.parse_spec`) and set on ``base``.
 
     Raises:
-        ModelError: ``@`` names another image network, or ``+imagenet`` asks for weights the
-            spec's image network has none of offline (only EfficientNet-Lite0 has).
+        ModelError: an unknown name or network, or ``+imagenet`` asking for weights the spec's
+            image network has none of offline; the message lists the choices.
     """
-    boxes = scene_term(spec)
-    trained = spec.removesuffix(boxes)
-    imagenet = trained.endswith(_IMAGENET)
-    name, _, network = trained.removesuffix(_IMAGENET).partition("@")
-    config = base.replace(model=name)
-    if network:
-        if network != "lite0" or not name.startswith("seannet"):
-            raise ModelError(f"model {spec!r}: '@' takes 'lite0' after a seannet model")
-        config = config.replace(backbone=LITE0)
-    if imagenet and config.model.image_family != LITE0:
-        raise ModelError(
-            f"model {spec!r}: +imagenet needs the EfficientNet-Lite0 network "
-            f"(seannet@lite0 or {LITE0}); no other ImageNet weights install offline"
-        )
-    pretrained = Path(LITE0_WEIGHTS) if imagenet else None
-    return ModelSpec(spec, trained, config, pretrained, boxes)
+    parsed = parse_spec(spec)
+    config = base.replace(**parsed.model_fields())
+    pretrained = Path(parsed.pretrained) if parsed.pretrained else None
+    return ModelSpec(parsed.spec, parsed.trained, config, pretrained, parsed.scene)
 
 
 def compare_models(

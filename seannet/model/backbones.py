@@ -9,6 +9,7 @@ for EfficientNet-Lite0, from the weights file the optional ``lite`` extra instal
 
 from __future__ import annotations
 
+import importlib
 import importlib.resources
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -19,7 +20,7 @@ from torchvision import models
 
 from seannet.errors import ModelError
 from seannet.model.pretrained import load_pretrained
-from seannet.weights import LITE0, LITE0_WEIGHTS, WEIGHTS
+from seannet.weights import IMAGE_ENCODERS, LITE0, LITE0_WEIGHTS, NETWORKS, NetworkRecord
 
 __all__ = [
     "RESNET_DEPTHS",
@@ -31,34 +32,22 @@ __all__ = [
     "image_encoder",
 ]
 
-RESNET_DEPTHS: dict[int, Callable[..., models.ResNet]] = {
-    18: models.resnet18,
-    34: models.resnet34,
-    50: models.resnet50,
-}
 C4_STRIDE = 16  # stem /4, layer2 /2, layer3 /2: the C4 map is 1/16 of the input
 
 
-def _lite0_encoder(*, pretrained: str | Path | None = None, sha256: str | None = None) -> nn.Module:
-    """EfficientNet-Lite0's trunk and head in sequence: (B, 3, H, W) -> (B, 1280)."""
-    split = efficientnet_lite0_c4(pretrained=pretrained, sha256=sha256)
-    return nn.Sequential(split.backbone, split.head)
+def _builder(record: NetworkRecord) -> Callable[..., nn.Module]:
+    """The callable a record's ``builder`` (``module:callable``) names."""
+    module, _, attr = record.builder.partition(":")
+    return getattr(importlib.import_module(module), attr)
 
 
-# baseline name -> (builder, native feature width after dropping the classifier); torchvision's
-# builders take weights=None, EfficientNet-Lite0's (the optional `lite` extra) pretrained=
-_ENCODERS: dict[str, tuple[Callable[..., nn.Module], int]] = {
-    "resnet18": (models.resnet18, 512),
-    "resnet34": (models.resnet34, 512),
-    "resnet50": (models.resnet50, 2048),
-    "resnext50": (models.resnext50_32x4d, 2048),
-    "vgg16": (models.vgg16, 4096),
-    "googlenet": (models.googlenet, 1024),
-    "efficientnet_lite0": (_lite0_encoder, 1280),
+# SeanNet's ResNets by depth and the whole-image encoders: both read off the registry
+RESNET_DEPTHS: dict[int, Callable[..., models.ResNet]] = {
+    r.depth: _builder(r) for r in NETWORKS.values() if r.depth
 }
-ENCODER_NAMES = tuple(_ENCODERS)
+ENCODER_NAMES = IMAGE_ENCODERS
 
-_LITE0 = WEIGHTS[LITE0]
+_LITE0 = NETWORKS[LITE0]
 LITE0_SHA256 = next(iter(_LITE0.files.values()))
 
 
@@ -168,7 +157,7 @@ def efficientnet_lite0_c4(
 
     Shapes:
         - **input**: :math:`(B, 3, H, W)`, normalised with the Lite0 record's mean /
-          std (:data:`seannet.weights.WEIGHTS`) when using the ImageNet weights
+          std (:data:`seannet.weights.NETWORKS`) when using the ImageNet weights
         - **backbone output**: :math:`(B, 112, \lceil H/16 \rceil, \lceil W/16 \rceil)`
           (224 px: 14 x 14; 112 px: 7 x 7)
         - **head output**: :math:`(N, 1280)`
@@ -235,11 +224,14 @@ def image_encoder(
     Raises:
         ModelError: an unknown name, or pretrained weights that fail their checks.
     """
-    if name not in _ENCODERS:
+    if name not in ENCODER_NAMES:
         raise ModelError(f"image encoder {name!r}; expected one of {', '.join(ENCODER_NAMES)}")
-    builder, width = _ENCODERS[name]
-    if name == "efficientnet_lite0":
-        return builder(pretrained=pretrained, sha256=sha256), width
+    record = NETWORKS[name]
+    width = record.feature_width
+    if record.family == LITE0:
+        split = efficientnet_lite0_c4(pretrained=pretrained, sha256=sha256)
+        return nn.Sequential(split.backbone, split.head), width
+    builder = _builder(record)
     if pretrained is not None:
         pretrained = Path(pretrained)
     if name == "googlenet":

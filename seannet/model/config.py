@@ -7,12 +7,14 @@ from dataclasses import dataclass
 from typing import Any
 
 from seannet.errors import ModelError
-from seannet.weights import LITE0
+from seannet.weights import NETWORKS
 
 __all__ = ["BACKBONES", "MODEL_FIELDS", "ModelConfig", "VISUAL_FEATURES"]
 
 VISUAL_FEATURES = ("c4_head", "c5")
-BACKBONES = ("resnet", LITE0)
+# SeanNet's image networks: the families of the registry's networks with a C4 map
+BACKBONES = tuple(dict.fromkeys(r.family for r in NETWORKS.values() if r.c4_channels))
+_DEPTHS = tuple(r.depth for r in NETWORKS.values() if r.depth)
 
 
 @dataclass(frozen=True)
@@ -21,8 +23,8 @@ class ModelConfig:
     :class:`~seannet.training.config.TrainConfig`); :func:`~seannet.model.build_model`,
     :class:`~seannet.model.SeanNet` and the transforms read their defaults from here."""
 
-    # seannet | an ablation (seannet-image, seannet-graph, ...) | resnet18 | resnet34 |
-    # resnet50 | resnext50 | vgg16 | googlenet | efficientnet_lite0
+    # seannet | an ablation (seannet-image, ...) | an image encoder of the registry
+    # (seannet.model.specs.MODEL_NAMES lists them)
     name: str = "seannet"
     # SeanNet's image network: "resnet" (of ``depth``) or "efficientnet_lite0" (the `lite` extra)
     backbone: str = "resnet"
@@ -57,8 +59,10 @@ class ModelConfig:
             raise ModelError(
                 f"model.backbone {self.backbone!r}: expected one of {', '.join(BACKBONES)}"
             )
-        if self.depth not in (18, 34, 50):
-            raise ModelError(f"model.depth {self.depth}: expected 18, 34 or 50")
+        if self.depth not in _DEPTHS:
+            raise ModelError(
+                f"model.depth {self.depth}: expected one of {', '.join(map(str, _DEPTHS))}"
+            )
         if not 0.0 <= self.dropout < 1.0:
             raise ModelError(f"model.dropout must be within [0, 1), got {self.dropout}")
         if self.layout_grid < 0 or self.layout_sketch < 0:
@@ -70,7 +74,8 @@ class ModelConfig:
     @property
     def image_family(self) -> str:
         """The image network's family, which fixes the input normalisation."""
-        return LITE0 if LITE0 in (self.name, self.backbone) else "resnet"
+        record = NETWORKS.get(self.name)
+        return record.family if record is not None else self.backbone
 
     def replace(self, **changes: Any) -> ModelConfig:
         """A copy with some fields changed (validated again)."""

@@ -13,22 +13,11 @@ from seannet.model.backbones import ENCODER_NAMES
 from seannet.model.baselines import ImageEncoder
 from seannet.model.config import ModelConfig
 from seannet.model.seannet import SeanNet
+from seannet.model.specs import ABLATIONS, MODEL_NAMES, SEANNET
 from seannet.model.wordvectors import WordVectorTable
 
 __all__ = ["ABLATIONS", "LAYOUT_PRIOR", "MODEL_NAMES", "build_model"]
 
-# SeanNet ablations by model name (paper-style "what each branch adds"): SeanNet kwargs
-ABLATIONS: dict[str, dict] = {
-    "seannet-image": {"branches": "image"},
-    "seannet-graph": {"branches": "graph"},
-    "seannet-noword": {"object_inputs": ("visual", "box")},
-    "seannet-novisual": {"object_inputs": ("box", "word")},
-    "seannet-nobox": {"object_inputs": ("visual", "word")},
-    "seannet-nolayout": {"layout_grid": 0},  # the paper's graph branch: GCN pathways only
-    # a 512-wide GCN fc instead of the paper's 4,096: a CPU step near ResNet-18's
-    "seannet-fc512": {"graph_hidden_dim": 512},
-}
-MODEL_NAMES = ("seannet", *ABLATIONS, *ENCODER_NAMES)
 # the layout pathway's starting class weight by dynamics category: boxes of objects people
 # move say little about the pose. On `medium`'s val triplets the layout vector alone ranked
 # 70.7 % with every class at 1 and 75.7 % with high-dynamic classes at 0.25, and SeanNet's best
@@ -76,7 +65,7 @@ def build_model(
             pretrained=pretrained,
             pretrained_sha256=pretrained_sha256,
         )
-    if name != "seannet" and name not in ABLATIONS:
+    if name != SEANNET and name not in ABLATIONS:
         raise ModelError(f"model {name!r}; expected one of {', '.join(MODEL_NAMES)}")
     if word_vectors is None:
         from seannet.model.wordvectors import load_table

@@ -16,7 +16,7 @@ import torch
 from torch import Tensor, nn
 
 from seannet.errors import ModelError
-from seannet.weights import WEIGHTS
+from seannet.weights import NETWORKS
 from sgdata.fileio import sha256_file
 
 __all__ = [
@@ -68,7 +68,7 @@ def _check_hash(path: Path, actual: str, arch: str, sha256: str | None) -> None:
                 f"{actual}; the file is corrupt or not the one meant"
             )
         return
-    record = WEIGHTS.get(arch)
+    record = NETWORKS.get(arch)
     if record is not None and record.known_digest(actual):
         return
     names = ", ".join(record.files) if record else "none"
@@ -83,7 +83,7 @@ def load_state_dict_file(path: Path, *, arch: str, sha256: str | None = None) ->
 
     Args:
         path: a local ``.pth`` file holding a ``{name: tensor}`` mapping.
-        arch: architecture key of :data:`seannet.weights.WEIGHTS`, used when ``sha256`` is ``None``.
+        arch: a network of :data:`seannet.weights.NETWORKS`, used when ``sha256`` is ``None``.
         sha256: the expected digest (64 hex digits, or a prefix of at least 8).
 
     Raises:

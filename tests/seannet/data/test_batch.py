@@ -10,9 +10,9 @@ import torch
 
 from seannet.data.batch import SceneBatch, normalise_pixels
 from seannet.errors import DataError
-from seannet.weights import IMAGENET_MEAN, IMAGENET_STD, LITE0, WEIGHTS
+from seannet.weights import IMAGENET_MEAN, IMAGENET_STD, LITE0, NETWORKS
 
-LITE0_MEAN, LITE0_STD = WEIGHTS[LITE0].mean, WEIGHTS[LITE0].std
+LITE0_MEAN, LITE0_STD = NETWORKS[LITE0].mean, NETWORKS[LITE0].std
 
 M = 16
 

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 from seannet.data.box_noise import BoxNoise
-from seannet.evaluation import eval as evaluation
+from seannet.evaluation import run_eval as evaluation
 from seannet.evaluation.embedding_cache import CACHE_DIR, cached_embeddings
-from seannet.evaluation.eval import evaluate_run
 from seannet.evaluation.metrics import Embeddings
+from seannet.evaluation.run_eval import evaluate_run
 
 
 def _embeddings(seed: int) -> Embeddings:

@@ -10,7 +10,7 @@ import pytest
 
 from seannet.data.box_noise import BoxNoise
 from seannet.errors import DataError
-from seannet.evaluation.eval import eval_file, evaluate_run
+from seannet.evaluation.run_eval import eval_file, evaluate_run
 from seannet.training.config import TrainConfig
 from seannet.training.train import train
 

@@ -148,7 +148,7 @@ def test_seannet_on_the_lite0_backbone_embeds_and_normalises_its_way() -> None:
     from seannet.data.view_inputs import ImageTransform
     from seannet.model.factory import build_model
     from seannet.training.config import TrainConfig
-    from seannet.weights import LITE0, WEIGHTS
+    from seannet.weights import LITE0, NETWORKS
 
     torch.manual_seed(0)
     model = build_model(
@@ -171,4 +171,4 @@ def test_seannet_on_the_lite0_backbone_embeds_and_normalises_its_way() -> None:
     assert out.shape == (2, 64 + model.layout.out_dim) and torch.isfinite(out).all()  # + layout
     config = TrainConfig().replace(backbone="efficientnet_lite0")
     transform = ImageTransform.for_model(112, config.model.image_family)
-    assert transform.mean == WEIGHTS[LITE0].mean
+    assert transform.mean == NETWORKS[LITE0].mean

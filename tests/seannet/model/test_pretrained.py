@@ -10,7 +10,7 @@ from torchvision import models
 
 from seannet import ImageEncoder, ModelError, SeanNet, build_model
 from seannet.model.pretrained import file_sha256, load_pretrained, load_state_dict_file
-from seannet.weights import WEIGHTS, WeightsRecord
+from seannet.weights import NETWORKS, NetworkRecord
 
 
 @pytest.fixture(scope="module")
@@ -33,7 +33,7 @@ def test_known_hashes_are_torchvisions() -> None:
     }
     for arch, ws in weights.items():
         expected = {w.url.rsplit("/", 1)[1]: w.url.rsplit("-", 1)[1][:-4] for w in ws}
-        assert WEIGHTS[arch].files == expected
+        assert NETWORKS[arch].files == expected
 
 
 def test_right_hash_loads_the_weights(resnet18_file: tuple[Path, dict]) -> None:
@@ -74,8 +74,8 @@ def test_known_prefix_is_accepted(
     resnet18_file: tuple[Path, dict], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     path, state = resnet18_file
-    local = WeightsRecord("resnet18", {"local.pth": file_sha256(path)[:8]})
-    monkeypatch.setitem(WEIGHTS, "resnet18", local)
+    local = NetworkRecord("resnet18", {"local.pth": file_sha256(path)[:8]})
+    monkeypatch.setitem(NETWORKS, "resnet18", local)
     model = load_pretrained(models.resnet18(weights=None), path, arch="resnet18")
     assert torch.equal(model.conv1.weight, state["conv1.weight"])
 

@@ -14,7 +14,7 @@ import torch
 
 from seannet.data.datasets import ImageTransform, TripletDataset, collate_triplets
 from seannet.errors import CheckpointError
-from seannet.evaluation.eval import evaluate_run
+from seannet.evaluation.run_eval import evaluate_run
 from seannet.model.loss import TripletLoss
 from seannet.training.config import TrainConfig
 from seannet.training.runs import build_for_dataset, load_checkpoint

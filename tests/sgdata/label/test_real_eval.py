@@ -48,7 +48,7 @@ def _real_dataset(tmp_path: Path) -> Path:
 
 
 def test_eval_runs_on_a_real_dataset(tmp_path: Path, mini_dataset: Path) -> None:
-    from seannet.evaluation.eval import evaluate_run
+    from seannet.evaluation.run_eval import evaluate_run
     from seannet.training.config import TrainConfig
     from seannet.training.train import train
 

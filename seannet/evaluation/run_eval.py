@@ -1,0 +1,311 @@
+"""``seannet eval``: evaluate a run's best checkpoint and write JSON, markdown and heat maps.
+
+(Formerly ``seannet.evaluation.eval``, a name that shadowed the builtin and that tests renamed
+on import.)
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from PIL import Image, ImageDraw, ImageFont
+
+from seannet.data.box_noise import BoxNoise
+from seannet.data.datasets import ImageTransform, ObservationDataset, TripletDataset, open_dataset
+from seannet.data.moved import moved_objects
+from seannet.errors import DataError
+from seannet.evaluation.box_kernel import SlotPairs, fit_box_kernel, slot_pairs
+from seannet.evaluation.box_overlap import SlotBoxes, choose_box_weight
+from seannet.evaluation.embedding_cache import cached_embeddings
+from seannet.evaluation.metrics import (
+    MAX_OFFSET,
+    Embeddings,
+    choose_threshold,
+    embed_split,
+    example_groups,
+    offset_statistics,
+    pose_pairs,
+    similarity_of,
+    threshold_quality,
+    triplet_metrics,
+    triplet_similarities,
+)
+from seannet.evaluation.retrieval import accuracy_by_moved, map_recall, separation
+from seannet.model.specs import SCENE_TERMS
+from seannet.training.runs import MODEL_KEYS, restore_run
+from sgdata.errors import SgdataError
+from sgdata.fileio import atomic_write_text, save_png
+
+__all__ = ["draw_heatmap", "eval_file", "evaluate_run"]
+
+
+def evaluate_run(
+    run: Path,
+    data: Path,
+    *,
+    split: str = "test",
+    out: Path | None = None,
+    boxes: str = "",
+    noise: BoxNoise | None = None,
+) -> dict:
+    """Evaluate ``run/best.pt`` on ``split`` of ``data``; writes ``eval_<split><tag>.*`` files.
+
+    Every choice is read off the validation split (epsilon; with ``boxes``, lambda), under
+    the same box noise as ``split``; the split evaluated only gives figures.
+
+    Args:
+        boxes: a scene term of :data:`SCENE_TERMS` (``""``: none): score pairs
+            ``S + lambda * S_scene``, lambda chosen on val (``+boxes``: the hand-made overlap;
+            ``+box-kernel``: the kernel learned on train). Tagged with the term's name.
+        noise: evaluate with the boxes a labeler or detector would give (:class:`BoxNoise`).
+            Tag ``_S<jitter>-P<drop>-Q<spurious>``.
+
+    Raises:
+        CheckpointError: no checkpoint, or it was trained on another dataset.
+        DataError: the dataset or split is missing; ``boxes`` on a dataset with no val split,
+            ``+box-kernel`` on one with no train split.
+    """
+    if boxes and boxes not in SCENE_TERMS:
+        raise ValueError(f"boxes={boxes!r}: expected one of {', '.join(SCENE_TERMS)} or ''")
+    out = out or run
+    ds = open_dataset(data)
+    # photos: another dataset by design, but the same vocabulary
+    restored = restore_run(run, data, keys=MODEL_KEYS if _all_real(ds, split) else None)
+    config, model, device, state = restored.config, restored.model, restored.device, restored.state
+
+    def embedded(name: str) -> Embeddings:
+        compute = lambda: embed_split(model, config, data, name, device, noise=noise)  # noqa: E731
+        return cached_embeddings(run, data, name, noise, compute)
+
+    evaluated = embedded(split)
+    transform = ImageTransform.for_model(config.model.image_size, config.model.image_family)
+    triplets = TripletDataset(data, split, transform=transform)
+    s_ap, s_an = triplet_similarities(evaluated, triplets)
+    val = None
+    if "val" in ds.splits:
+        val = evaluated if split == "val" else embedded("val")
+    name, tag = config.model.name + boxes, _tag(boxes, noise)
+    choices: dict[str, Any] = {}
+    if boxes:
+        if val is None:
+            raise DataError(f"{data}: {boxes} chooses lambda on the val split, and there is none")
+        val_triplets = (
+            triplets if split == "val" else TripletDataset(data, "val", transform=transform)
+        )
+        scene = _SceneScores(boxes, data, noise)
+        choices.update(scene.fit)
+        v_ap, v_an = triplet_similarities(val, val_triplets)
+        b_ap, b_an = scene.triplets(val, val_triplets)
+        weight, by_weight = choose_box_weight(v_ap, v_an, b_ap, b_an)
+        o_ap, o_an = scene.triplets(evaluated, triplets)
+        s_ap, s_an = s_ap + weight * o_ap, s_an + weight * o_an
+        choices["box_weight"] = {"lambda": weight, "val_accuracy_by_lambda": by_weight}
+    metrics = triplet_metrics(triplets, s_ap, s_an)
+    moved = moved_objects(data, split, triplets.obs)
+    if val is not None:
+        threshold = choose_threshold(val)
+        rule = "max balanced accuracy, same pose vs one step (val)"
+    else:  # a real dataset holds one split: choosing epsilon on it would grade its own choice
+        threshold = {"epsilon": float("nan"), "balanced_accuracy": float("nan")}
+        rule = "not chosen: the dataset has no val split"
+    quality = threshold_quality(evaluated, threshold["epsilon"])
+    stats = offset_statistics(evaluated)
+    result: dict[str, Any] = {
+        "run": str(run),
+        "model": name,
+        "split": split,
+        "epoch": state["epoch"],
+        "noise": asdict(noise) if noise is not None else None,
+        **choices,
+        **metrics,
+        # epsilon, retrieval and the offset statistics read the embedding alone
+        "threshold": {**threshold, "rule": rule},
+        "threshold_on_split": quality,
+        "retrieval": map_recall(evaluated),
+        "by_moved": accuracy_by_moved(s_ap > s_an, moved),
+        "separation": separation(*pose_pairs(evaluated)),
+        "offset_mean": _plain(stats["mean"]),
+        "offset_std": _plain(stats["std"]),
+        "offset_count": stats["count"].astype(int).tolist(),
+    }
+    out.mkdir(parents=True, exist_ok=True)
+    if not tag:  # the pictures are the embedding's: drawn once, for the plain evaluation
+        result["examples"] = _examples(evaluated, triplets, out, split, name)
+        save_png(
+            draw_heatmap(stats["mean"], f"{name}: mean S by offset"), out / f"heat_mean_{split}.png"
+        )
+        save_png(
+            draw_heatmap(stats["std"], f"{name}: std S by offset"), out / f"heat_std_{split}.png"
+        )
+    atomic_write_text(out / f"eval_{split}{tag}.json", json.dumps(result, indent=2))
+    atomic_write_text(out / f"eval_{split}{tag}.md", _markdown(result))
+    return result
+
+
+def eval_file(run: Path, split: str, *, boxes: str = "", noise: BoxNoise | None = None) -> Path:
+    """Where :func:`evaluate_run` writes its JSON for these options."""
+    return run / f"eval_{split}{_tag(boxes, noise)}.json"
+
+
+def _tag(boxes: str, noise: BoxNoise | None) -> str:
+    tag = boxes
+    if noise is not None and noise.active:
+        tag += f"_{noise.label()}"
+    return tag
+
+
+class _SceneScores:
+    """``S_scene(A, P)`` and ``S_scene(A, N)`` of triplets, from the boxes the model saw:
+    the hand-made overlap, or the kernel fit on the train triplets' boxes (same noise)."""
+
+    def __init__(self, term: str, data: Path, noise: BoxNoise | None) -> None:
+        self.kernel = None
+        self.fit: dict[str, Any] = {}
+        if term == "+box-kernel":
+            ds = open_dataset(data)
+            if "train" not in ds.splits:
+                raise DataError(f"{data}: +box-kernel learns on the train split, and there is none")
+            views = ObservationDataset(data, "train", noise=noise)
+            boxes = SlotBoxes(views.obs_ids, *views.slot_boxes(), views.num_slots)
+            positive, negative = self._pairs(boxes, TripletDataset(data, "train").obs)
+            self.kernel, accuracy = fit_box_kernel(positive, negative, views.num_slots)
+            self.fit = {
+                "box_kernel": {"train_triplets": positive.pairs, "train_accuracy": accuracy}
+            }
+
+    @staticmethod
+    def _pairs(boxes: SlotBoxes, obs: list[tuple[str, str, str]]) -> tuple[SlotPairs, SlotPairs]:
+        anchors, positives, negatives = zip(*obs, strict=True) if obs else ((), (), ())
+        return slot_pairs(boxes, anchors, positives), slot_pairs(boxes, anchors, negatives)
+
+    def triplets(
+        self, embeddings: Embeddings, triplets: TripletDataset
+    ) -> tuple[np.ndarray, np.ndarray]:
+        assert embeddings.slot_boxes is not None  # embed_split always fills it
+        boxes = SlotBoxes(embeddings.obs_ids, *embeddings.slot_boxes, embeddings.num_slots)
+        if self.kernel is None:
+            anchors, positives, negatives = (
+                zip(*triplets.obs, strict=True) if triplets.obs else ((), (), ())
+            )
+            return boxes.overlap(anchors, positives), boxes.overlap(anchors, negatives)
+        positive, negative = self._pairs(boxes, triplets.obs)
+        return self.kernel.score(positive), self.kernel.score(negative)
+
+
+def _all_real(ds, split: str) -> bool:  # noqa: ANN001
+    """Whether every observation of ``split`` is a real photo (``domain = "real"``)."""
+    try:
+        domains = ds.observations(split, columns=["domain"]).column("domain").to_pylist()
+    except SgdataError:  # a missing split: the loaders below name it
+        return False
+    return bool(domains) and set(domains) == {"real"}
+
+
+def _plain(grid: np.ndarray) -> list[list[float | None]]:
+    return [[None if math.isnan(v) else round(float(v), 4) for v in row] for row in grid]
+
+
+def _markdown(result: dict) -> str:
+    retrieval, nan = result["retrieval"], float("nan")
+    lines = [
+        f"# {result['model']} on {result['split']} (epoch {result['epoch']})",
+        "",
+        f"- triplet accuracy: **{100 * result['accuracy']:.2f} %** "
+        f"over {result['triplets']} triplets",
+        f"- mean S(A,P) - S(A,N): {result['mean_gap']:.3f}",
+        f"- threshold epsilon (val): {result['threshold']['epsilon']:.3f}; "
+        f"precision {result['threshold_on_split']['precision']:.3f}, "
+        f"recall {result['threshold_on_split']['recall']:.3f} on {result['split']}",
+        f"- recall@1 / @5 of the same pose in the layout-0 map: "
+        f"{100 * retrieval['recall'][1]:.1f} / {100 * retrieval['recall'][5]:.1f} % over "
+        f"{retrieval['queries']} queries in {retrieval['rooms']} rooms",
+        f"- same pose vs one step: S {result['separation'].get('same_pose_mean', nan):.3f} vs "
+        f"{result['separation'].get('one_step_mean', nan):.3f}, "
+        f"d' = {result['separation']['d_prime']:.2f}",
+        "",
+        "| moved objects in view | triplets | accuracy |",
+        "|---|---|---|",
+        *(
+            f"| {k} | {v['triplets']} | {100 * v['accuracy']:.1f} % |"
+            for k, v in result["by_moved"].items()
+        ),
+        "",
+        "| tier | accuracy |",
+        "|---|---|",
+        *(f"| {k} | {100 * v:.1f} % |" for k, v in result["per_tier"].items()),
+        "",
+        "| room | accuracy |",
+        "|---|---|",
+        *(f"| {k} | {100 * v:.1f} % |" for k, v in result["per_room"].items()),
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def draw_heatmap(grid: np.ndarray, title: str) -> Image.Image:
+    """Similarity by grid offset: rows delta i, columns delta j, both -4 .. +4."""
+    labels = [f"{k - MAX_OFFSET:+d}" for k in range(grid.shape[0])]
+    return draw_matrix(grid, labels, labels, title)
+
+
+def draw_matrix(
+    grid: np.ndarray, rows: list[str], columns: list[str], title: str, *, cell: int = 44
+) -> Image.Image:
+    """A matrix of values as coloured, numbered cells (NaN cells grey), with labels."""
+    margin = 40
+    height, width = grid.shape
+    image = Image.new("RGB", (margin + width * cell + 10, margin + height * cell + 24), "white")
+    draw = ImageDraw.Draw(image)
+    font = ImageFont.load_default(size=11)
+    draw.text((4, 4), title, fill="black", font=font)
+    finite = grid[np.isfinite(grid)]
+    lo, hi = (float(finite.min()), float(finite.max())) if len(finite) else (0.0, 1.0)
+    for r in range(height):
+        y = margin + r * cell
+        draw.text((margin - 6, y + cell / 2), rows[r], fill="black", font=font, anchor="rm")
+        for c in range(width):
+            x = margin + c * cell
+            value = grid[r, c]
+            if not math.isfinite(value):
+                draw.rectangle([x, y, x + cell - 1, y + cell - 1], fill=(235, 235, 235))
+                continue
+            t = (value - lo) / (hi - lo) if hi > lo else 1.0
+            color = (int(255 * t), int(80 + 100 * (1 - abs(2 * t - 1))), int(255 * (1 - t)))
+            draw.rectangle([x, y, x + cell - 1, y + cell - 1], fill=color)
+            draw.text(
+                (x + cell / 2, y + cell / 2), f"{value:.3f}", fill="white", font=font, anchor="mm"
+            )
+    for c in range(width):
+        draw.text(
+            (margin + c * cell + cell / 2, margin + height * cell + 8),
+            columns[c],
+            fill="black",
+            font=font,
+            anchor="mm",
+        )
+    return image
+
+
+def _examples(evaluated, triplets: TripletDataset, out: Path, split: str, model: str) -> list:  # noqa: ANN001
+    """Pairwise similarity of a few tier-0 triplets with their extra positives (paper Fig. 7)."""
+    examples = []
+    pictures = []
+    for group in example_groups(evaluated, triplets):
+        labels = ["A", *(f"P{k}" for k in range(1, len(group) - 1)), "N"]
+        matrix = similarity_of(evaluated, group)
+        examples.append({"ids": group, "labels": labels, "similarity": matrix.round(4).tolist()})
+        pictures.append(draw_matrix(matrix, labels, labels, f"{model}: {group[0]}"))
+    if pictures:
+        sheet = Image.new(
+            "RGB", (sum(p.width for p in pictures), max(p.height for p in pictures)), "white"
+        )
+        x = 0
+        for picture in pictures:
+            sheet.paste(picture, (x, 0))
+            x += picture.width
+        save_png(sheet, out / f"examples_{split}.png")
+    return examples
