@@ -516,6 +516,78 @@ def export(
     )
 
 
+assets_app = typer.Typer(
+    help="Objects you bring: mesh files as catalog classes (docs/rooms.md).",
+    no_args_is_help=True,
+)
+app.add_typer(assets_app, name="assets")
+
+
+@assets_app.command("add")
+def assets_add(
+    folder: Annotated[Path, typer.Argument(help="Folder of mesh files: one variant each.")],
+    class_name: Annotated[str, typer.Option("--class", help="Catalog class, e.g. Mug.")],
+    catalog: Annotated[
+        Path, typer.Option(help="User catalog file to write ([catalog] files of a config).")
+    ] = Path("catalog.toml"),
+    dynamics: Annotated[str | None, typer.Option(help="static | low | high")] = None,
+    placement: Annotated[
+        str | None, typer.Option(help="floor | wall_floor | wall | surface | part")
+    ] = None,
+    on: Annotated[
+        list[str] | None, typer.Option(help="Receptacle class it rests on (repeatable).")
+    ] = None,
+    inside: Annotated[
+        list[str] | None, typer.Option(help="Container class it rests in (repeatable).")
+    ] = None,
+    up: Annotated[
+        str | None, typer.Option(help="The files' up axis: y | z (default: measured).")
+    ] = None,
+    units: Annotated[
+        str | None, typer.Option(help="The files' unit: m | cm | mm (default: measured).")
+    ] = None,
+    scale: Annotated[
+        str | None, typer.Option(help="keep (true size, default) | fit (into the size bounds)")
+    ] = None,
+    front: Annotated[
+        str | None, typer.Option(help="The files' front axis: -y | +y | -x | +x")
+    ] = None,
+) -> None:
+    """Write a catalog class for a folder of mesh files and print what was measured."""
+    from sgdata.world.asset_entries import add_asset_class
+
+    added = add_asset_class(
+        folder,
+        class_name,
+        catalog,
+        dynamics=dynamics,
+        placement=placement,
+        receptacles=tuple(on or ()),
+        containers=tuple(inside or ()),
+        up=up,
+        units=units,
+        scale=scale,
+        front=front,
+    )
+    verb = "new class" if added.new else "overrides the shipped class"
+    table = Table(title=f"{added.name} ({verb}) in {added.catalog}")
+    for column in ("file", "format", "up", "unit", "size (m)", "triangles", "surfaces"):
+        table.add_column(column, justify="left" if column == "file" else "right")
+    for asset in added.assets:
+        surfaces = ", ".join(f"{'in' if s.inside else 'top'} {s.z:.3f}" for s in asset.surfaces)
+        table.add_row(
+            Path(asset.path).name,
+            Path(asset.path).suffix.lstrip("."),
+            asset.up.upper(),
+            asset.units,
+            " x ".join(f"{v:.3f}" for v in asset.size),
+            str(asset.triangles),
+            surfaces or "-",
+        )
+    console.print(table)
+    console.print(added.entry.rstrip(), markup=False, highlight=False)
+
+
 main = run_app(app, "sgdata")
 
 if __name__ == "__main__":

@@ -16,7 +16,7 @@ import os
 from pathlib import Path
 
 from sgdata.errors import ConfigError
-from sgdata.dataset.rows import sha256_file
+from sgdata.fileio import sha256_file
 from sgdata.pipeline.config import AssetFile, GenerateConfig
 
 __all__ = ["resolve_user_assets"]

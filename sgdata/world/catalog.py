@@ -143,8 +143,18 @@ def default_catalog_path() -> Path:
 
 
 @cache
-def _load_cached(path: str, extra: tuple[str, ...]) -> Catalog:
-    return _parse(Path(path), tuple(Path(p) for p in extra))
+def _load_cached(path: str, extra: tuple[tuple[str, int, int], ...]) -> Catalog:
+    return _parse(Path(path), tuple(Path(p) for p, _, _ in extra))
+
+
+def _stamped(path: Path) -> tuple[str, int, int]:
+    """A user catalog file's cache key: its path, modification time and size (an edited file
+    is read again)."""
+    try:
+        stat = path.stat()
+    except OSError:
+        return (str(path), 0, -1)  # _parse names it missing
+    return (str(path), stat.st_mtime_ns, stat.st_size)
 
 
 def load_catalog(path: str | Path | None = None, *, extra: Sequence[str | Path] = ()) -> Catalog:
@@ -158,7 +168,7 @@ def load_catalog(path: str | Path | None = None, *, extra: Sequence[str | Path] 
         CatalogError: naming the file, the class and the field at fault (or the mesh file).
     """
     resolved = Path(path) if path is not None else default_catalog_path()
-    extras = tuple(str(Path(p).resolve()) for p in extra)
+    extras = tuple(_stamped(Path(p).resolve()) for p in extra)
     return _load_cached(str(resolved.resolve()), extras)
 
 

@@ -1,0 +1,149 @@
+"""``sgdata assets add``: a catalog entry for a folder of mesh files, written after measuring them.
+
+The entry goes into a user catalog file (``[catalog] files`` of a config): a class of the
+shipped catalog keeps its rules and size bounds and only gets ``mesh`` (and the options given);
+a new class gets its size bounds from the files' measured sizes (10 % either way), so it needs
+its dynamics and placement, and ``--on`` receptacles when it rests on surfaces. The file is
+rewritten only once the merged catalog loads with the new entry, so a bad mesh leaves it as it
+was.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from sgdata.errors import CatalogError
+from sgdata.fileio import atomic_write_text
+from sgdata.world.catalog import PLACEMENTS, load_catalog
+from sgdata.world.mesh_assets import MESH_FORMATS, MeshAsset, class_assets
+
+__all__ = ["AddedClass", "add_asset_class"]
+
+SIZE_MARGIN = 0.1  # a new class's bounds: its files' sizes, this share either way
+_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
+
+
+@dataclass(frozen=True)
+class AddedClass:
+    """What ``add_asset_class`` wrote and measured."""
+
+    name: str
+    catalog: Path  # the user catalog file written
+    entry: str  # the TOML table written
+    assets: tuple[MeshAsset, ...]  # the files, measured (variant order)
+    new: bool  # a class the shipped catalog lacks
+
+
+def add_asset_class(
+    folder: Path,
+    class_name: str,
+    catalog: Path,
+    *,
+    dynamics: str | None = None,
+    placement: str | None = None,
+    receptacles: tuple[str, ...] = (),
+    containers: tuple[str, ...] = (),
+    up: str | None = None,
+    units: str | None = None,
+    scale: str | None = None,
+    front: str | None = None,
+) -> AddedClass:
+    """Write (or replace) ``class_name``'s entry in ``catalog`` for the mesh files in
+    ``folder``, and measure them.
+
+    Raises:
+        CatalogError: no mesh file in ``folder``, a new class without dynamics or placement, a
+            bad mesh, or an entry the merged catalog refuses (the file is left unchanged).
+    """
+    folder, catalog = Path(folder), Path(catalog)
+    if not _NAME.fullmatch(class_name):
+        raise CatalogError(f"class name {class_name!r}: expected a CamelCase name such as Mug")
+    suffixes = sorted(
+        {p.suffix.lower() for p in folder.glob("*") if p.suffix.lower() in MESH_FORMATS}
+    )
+    if not suffixes:
+        raise CatalogError(
+            f"{folder}: no mesh file ({', '.join(sorted(MESH_FORMATS))}); put the files there"
+        )
+    shipped = load_catalog()
+    new = class_name not in shipped
+    rel = Path(os.path.relpath(folder.resolve(), catalog.resolve().parent)).as_posix()
+    fields: dict[str, object] = {"mesh": [f"{rel}/*{s}" for s in suffixes]}
+    if len(suffixes) == 1:
+        fields["mesh"] = f"{rel}/*{suffixes[0]}"
+    options = {"up": up, "units": units, "scale": scale, "front": front}
+    fields.update({k: v for k, v in options.items() if v is not None})
+    if dynamics is not None:
+        fields["dynamics"] = dynamics
+    if placement is not None:
+        if placement not in PLACEMENTS:
+            raise CatalogError(f"placement {placement!r}: expected one of {PLACEMENTS}")
+        fields["placement"] = placement
+    if receptacles:
+        fields["receptacles"] = list(receptacles)
+    if containers:
+        fields["containers"] = list(containers)
+    if new:
+        if dynamics is None or placement is None:
+            raise CatalogError(
+                f"class {class_name} is not in the shipped catalog: give --dynamics and "
+                "--placement (and --on for surface placement)"
+            )
+        fields["size_min"], fields["size_max"] = [0.001] * 3, [1000.0] * 3
+    before = catalog.read_text(encoding="utf-8") if catalog.is_file() else ""
+    text = _with_entry(before, class_name, fields)
+    if new:  # measure once with open bounds, then bound the class by what was measured
+        assets = _load(catalog, text, class_name)
+        lo = [min(a.size[k] for a in assets) * (1 - SIZE_MARGIN) for k in range(3)]
+        hi = [max(a.size[k] for a in assets) * (1 + SIZE_MARGIN) for k in range(3)]
+        fields["size_min"] = [round(v, 3) for v in lo]
+        fields["size_max"] = [round(v, 3) for v in hi]
+        text = _with_entry(before, class_name, fields)
+    assets = _load(catalog, text, class_name)
+    return AddedClass(class_name, catalog, _table(class_name, fields), assets, new)
+
+
+def _load(catalog: Path, text: str, class_name: str) -> tuple[MeshAsset, ...]:
+    """Write ``text`` to ``catalog`` and load it merged; put the old file back on failure."""
+    before = catalog.read_bytes() if catalog.is_file() else None
+    atomic_write_text(catalog, text)
+    try:
+        merged = load_catalog(extra=[catalog])
+        return class_assets(merged[class_name])
+    except CatalogError:
+        if before is None:
+            catalog.unlink()
+        else:
+            catalog.write_bytes(before)
+        raise
+
+
+def _toml(value: object) -> str:
+    if isinstance(value, str):
+        return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(value, list):
+        return "[" + ", ".join(_toml(v) for v in value) + "]"
+    return repr(value)
+
+
+def _table(name: str, fields: dict[str, object]) -> str:
+    lines = [f"[classes.{name}]"] + [f"{k} = {_toml(v)}" for k, v in fields.items()]
+    return "\n".join(lines) + "\n"
+
+
+def _with_entry(text: str, name: str, fields: dict[str, object]) -> str:
+    """``text`` with the ``[classes.<name>]`` table replaced (or appended)."""
+    lines = text.splitlines(keepends=True)
+    start = next((i for i, ln in enumerate(lines) if ln.strip() == f"[classes.{name}]"), None)
+    if start is None:
+        head = text if not text or text.endswith("\n") else text + "\n"
+        return head + ("\n" if head else "") + _table(name, fields)
+    end = next(
+        (i for i in range(start + 1, len(lines)) if lines[i].lstrip().startswith("[")), len(lines)
+    )
+    while end > start + 1 and not lines[end - 1].strip():
+        end -= 1
+    return "".join(lines[:start]) + _table(name, fields) + "".join(lines[end:])
