@@ -9,9 +9,10 @@ sub-node's stored embedding and the robot stops when S > epsilon. At most ``k_ma
 steps per segment. Judged per step (:func:`step_verdict`), first failure ends the episode:
 
 - **collision**: a move into a cell off the layout's reachable grid, classified
-  (:func:`collision_cause`) as *path blocked* (the planned next cell is not reachable in the
-  episode's layout: no navigator could pass) or *navigator error* (it was, and the navigator
-  took another action);
+  (:func:`collision_cause`) as *path blocked* (from where the robot stood, no collision-free
+  sequence of forward / left / right moves on the episode's reachable grid reaches the
+  segment's goal within the segment's steps left: no navigator could pass) or *navigator
+  error* (one did: a sidestep around a moved object, say);
 - **localization**: the robot stopped (S > epsilon) away from the goal (a *false stop*), or
   stood on the goal without stopping and passes it (a *missed goal*);
 - **navigation**: ``k_max`` steps without stopping and without a localization failure;
@@ -62,6 +63,7 @@ __all__ = [
     "Step",
     "Timing",
     "collision_cause",
+    "free_path_steps",
     "ideal_action",
     "judge_episode",
     "judge_segment",
@@ -136,19 +138,49 @@ def segment_cells(start: Pose, goal: Pose) -> list[tuple[int, int]]:
 
 
 def collision_cause(
-    pose: Pose, start: Pose, goal: Pose, reachable: Callable[[int, int], bool]
+    pose: Pose,
+    start: Pose,
+    goal: Pose,
+    reachable: Callable[[int, int], bool],
+    steps_left: int = K_MAX,
 ) -> str:
     """Why a move from ``pose`` collided in the translation segment ``start`` -> ``goal``.
 
-    :data:`BLOCKED` when the robot stood on the segment's run and the planned next cell of
-    the run is not reachable in the episode's layout (no navigator could pass); otherwise
-    :data:`NAVIGATOR_ERROR` (the planned cell was free, or the robot had left the run).
+    :data:`BLOCKED` when no collision-free path of at most ``steps_left`` navigator moves
+    leads from ``pose`` to ``goal`` on the episode's reachable grid (:func:`free_path_steps`):
+    no navigator could pass; otherwise :data:`NAVIGATOR_ERROR` (a path was there, a sidestep
+    around a moved object, say, and the navigator took another action). ``start`` names the
+    segment; the search starts where the robot stood.
     """
-    run = segment_cells(start, goal)
-    here = pose[:2]
-    if pose[2] != goal[2] or here not in run or here == run[-1]:
+    del start  # the segment's start; the robot may have left its straight run
+    if pose[2] != goal[2]:  # a translation segment never turns: it drifted off somehow
         return NAVIGATOR_ERROR
-    return NAVIGATOR_ERROR if reachable(*run[run.index(here) + 1]) else BLOCKED
+    found = free_path_steps(pose, goal[:2], reachable, steps_left)
+    return BLOCKED if found is None else NAVIGATOR_ERROR
+
+
+def free_path_steps(
+    pose: Pose, cell: tuple[int, int], reachable: Callable[[int, int], bool], limit: int
+) -> int | None:
+    """The fewest forward / left / right moves (each one cell, the heading kept) from
+    ``pose`` to ``cell`` through reachable cells only, if at most ``limit``; else None.
+    A breadth-first search on the grid (backward is no navigator action)."""
+    heading = pose[2]
+    frontier, seen = [pose[:2]], {pose[:2]}
+    for depth in range(limit + 1):
+        if cell in seen:
+            return depth
+        nxt = []
+        for i, j in frontier:
+            for action in NAVIGATOR_ACTIONS:
+                there = apply((i, j, heading), action)[:2]
+                if there not in seen and reachable(*there):
+                    seen.add(there)
+                    nxt.append(there)
+        if not nxt:
+            return None
+        frontier = nxt
+    return None
 
 
 def ideal_action(pose: Pose, goal: Pose) -> str:
@@ -350,7 +382,8 @@ def run_episode(
                 action = clock.timed("navigator", policy.act, current.rgb, goal_image)
             nxt = apply(pose, action)
             if action not in TURNS and not live.reachable(nxt[0], nxt[1]):
-                cause = collision_cause(pose, a, b, live.reachable)
+                left = min(k_max, budget - used) - len(steps)  # this segment's steps left
+                cause = collision_cause(pose, a, b, live.reachable, int(left))
                 steps.append(Step(action, nxt, collided=True, cause=cause))
             else:
                 pose = nxt

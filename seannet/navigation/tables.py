@@ -1,5 +1,13 @@
-"""Table II from episode records: rates with Wilson 95 % intervals, failure splits, time;
-the results file and its wall times, written apart and read back together."""
+"""Table II from episode records: rates with 95 % intervals clustered by room, failure
+splits, time; the results file and its wall times, written apart and read back together.
+
+Episodes of one room share its map, its layouts and its localizer's view of them: rooms, not
+episodes, are the independent units. A rate's interval is a percentile bootstrap over the
+rooms (each draw a sample of rooms with replacement, its rate the pooled episodes' share),
+widened where needed to Wilson's interval of the episodes as if independent, so that a table
+of few rooms (one room: no spread between rooms to see) is never narrower than its count
+allows.
+"""
 
 from __future__ import annotations
 
@@ -9,6 +17,8 @@ import math
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from seannet.errors import NavigationError
 from seannet.markdown import table
 from seannet.navigation.config import RULES
@@ -16,12 +26,14 @@ from seannet.navigation.episodes import CASES, CAUSES, LOCALIZATION_KINDS, OUTCO
 from sgdata.fileio import atomic_write_text
 
 __all__ = [
+    "INTERVAL",
     "RULES",
     "Z95",
     "case_rates",
     "markdown",
     "rate_rows",
     "read_results",
+    "room_interval",
     "time_rows",
     "wilson",
     "write_results",
@@ -31,6 +43,8 @@ Z95 = 1.959963984540054  # the standard normal's 97.5 % quantile
 # what a row counts: the outcomes, then the two kinds of each failure the issue splits
 DETAILS = (*LOCALIZATION_KINDS, *CAUSES)
 TIME_PARTS = ("render", "embed", "navigator", "total")
+RESAMPLES = 4000  # bootstrap draws of the rooms
+_SEED = 0  # the bootstrap's own draws: the same table every time
 
 
 def wilson(successes: int, n: int, z: float = Z95) -> tuple[float, float]:
@@ -48,6 +62,25 @@ def wilson(successes: int, n: int, z: float = Z95) -> tuple[float, float]:
     return max(0.0, centre - half), min(1.0, centre + half)
 
 
+def room_interval(
+    counts: dict[str, tuple[int, int]], resamples: int = RESAMPLES
+) -> tuple[float, float]:
+    """95 % interval of a share pooled over rooms, ``counts`` room -> (hits, episodes): the
+    percentile bootstrap over the rooms, widened to :func:`wilson`'s of the pooled count
+    where that is wider. NaNs without episodes."""
+    hits = np.array([k for k, _ in counts.values()], dtype=np.float64)
+    sizes = np.array([n for _, n in counts.values()], dtype=np.float64)
+    total = sizes.sum() if len(sizes) else 0.0
+    low, high = wilson(int(hits.sum()) if len(hits) else 0, int(total))
+    if total == 0 or len(sizes) < 2:
+        return low, high
+    draw = np.random.default_rng(_SEED).integers(len(sizes), size=(resamples, len(sizes)))
+    n = sizes[draw].sum(axis=1)
+    shares = hits[draw].sum(axis=1)[n > 0] / n[n > 0]
+    b_low, b_high = np.percentile(shares, [2.5, 97.5])
+    return min(low, float(b_low)), max(high, float(b_high))
+
+
 def _ending(record: dict[str, Any], rule: str) -> tuple[str, str | None]:
     """(outcome, detail) of an episode under ``rule``."""
     if rule == "paper":
@@ -57,16 +90,24 @@ def _ending(record: dict[str, Any], rule: str) -> tuple[str, str | None]:
 
 def case_rates(records: list[dict[str, Any]], rule: str = "paper") -> dict[str, dict[str, Any]]:
     """Per case: ``total`` and, for every outcome and failure kind, its count, percent and
-    Wilson 95 % interval (percent); under ``replan`` also the mean replans per episode."""
+    95 % interval clustered by room (:func:`room_interval`, percent); under ``replan`` also
+    the mean replans per episode."""
     table: dict[str, dict[str, Any]] = {}
     for case in CASES:
         mine = [r for r in records if r["case"] == case]
         endings = [_ending(r, rule) for r in mine]
+        rooms = [r.get("room_id", "") for r in mine]
         n = len(endings)
         row: dict[str, Any] = {"total": n}
         for name in (*OUTCOMES, *DETAILS):
-            k = sum(1 for outcome, detail in endings if name in (outcome, detail))
-            low, high = wilson(k, n)
+            hit = [name in ending for ending in endings]
+            counts = {
+                room: (sum(h for h, r in zip(hit, rooms, strict=True) if r == room),
+                       rooms.count(room))
+                for room in dict.fromkeys(rooms)
+            }  # fmt: skip
+            k = sum(hit)
+            low, high = room_interval(counts)
             row[name] = {
                 "count": k,
                 "percent": 100.0 * k / n if n else math.nan,
@@ -88,6 +129,8 @@ def _label(run: dict[str, Any]) -> str:
     return f"{run['model']} ({run['label']})"
 
 
+# what a cell's interval is, for the documents that print them
+INTERVAL = "95 % interval: a bootstrap over rooms, at least Wilson's"
 RATE_HEADER = [
     "localizer",
     "cases N / A",
@@ -101,7 +144,7 @@ def rate_rows(
     results: dict[str, Any], rule: str = "paper", *, split: bool = False
 ) -> list[list[str]]:
     """Table II rows (``split``: the failure kinds instead) of every run under ``rule``;
-    each cell ``percent [Wilson 95 % low, high]`` for N, then A."""
+    each cell ``percent [95 % low, high]`` (clustered by room) for N, then A."""
     rows = []
     for run in results["runs"]:
         t = case_rates(run["episodes"], rule)
@@ -138,7 +181,7 @@ def markdown(results: dict[str, Any]) -> str:
         f"{results['episodes_per_case_and_room']} episodes per case and room, k_max "
         f"{results['k_max']}, map spacing {results['spacing']}, seed {results['seed']}, "
         f"navigator {results['navigator']}; N: neighbour sub-nodes, A: arbitrary sub-nodes. "
-        "Each cell: percent [Wilson 95 % interval], N / A.",
+        f"Each cell: percent [{INTERVAL}], N / A.",
     ]
     titles = {
         "paper": "The paper's rule (a collision ends the episode)",

@@ -18,6 +18,7 @@ from seannet.navigation.episodes import (
     NAVIGATOR_ERROR,
     Episode,
     collision_cause,
+    free_path_steps,
     ideal_action,
     run_episode,
     segment_cells,
@@ -47,8 +48,21 @@ def test_a_collision_on_a_blocked_run_is_no_navigators_fault() -> None:
     assert segment_cells((2, 2, 1), (2, 0, 1)) == [(2, 2), (2, 1), (2, 0)]
     with pytest.raises(NavigationError, match="straight"):
         segment_cells((0, 0, 0), (2, 2, 0))
-    # the planned next cell (1, 0) is blocked: whatever action hit a wall, no navigator passes
-    assert collision_cause((0, 0, 0), (0, 0, 0), (2, 0, 0), free) == BLOCKED
+    # the planned next cell (1, 0) is blocked, but a sidestep passes: left, forward, forward,
+    # right (4 moves); within the steps left that is the navigator's error, beyond them blocked
+    assert free_path_steps((0, 0, 0), (2, 0), free, 12) == 4
+    assert collision_cause((0, 0, 0), (0, 0, 0), (2, 0, 0), free, 12) == NAVIGATOR_ERROR
+    assert free_path_steps((0, 0, 0), (2, 0), free, 3) is None
+    assert collision_cause((0, 0, 0), (0, 0, 0), (2, 0, 0), free, 3) == BLOCKED
+    # a wall across the room: no navigator could pass, whatever the budget
+    wall = _mask(["...", "###", "..."])
+
+    def walled(i: int, j: int) -> bool:
+        return 0 <= i < 3 and 0 <= j < 3 and bool(wall[i, j])
+
+    assert collision_cause((0, 1, 0), (0, 1, 0), (2, 1, 0), walled, 100) == BLOCKED
+    # backward is no navigator move: a goal behind the robot is out of reach
+    assert free_path_steps((2, 1, 0), (0, 1), free, 100) is None
     # the run (0, 1) -> (2, 1) is free: a collision there is the navigator's
     assert ideal_action((0, 1, 0), (2, 1, 0)) == "forward"
     assert collision_cause((0, 1, 0), (0, 1, 0), (2, 1, 0), free) == NAVIGATOR_ERROR
@@ -94,13 +108,21 @@ def test_replanning_around_a_blocked_edge(
         episode = Episode(room, "N", 0, topo.layout, ((*a, heading), (*b, heading)))
 
         paper = run_episode(episode, topo, live, localizer, None)
-        assert (paper.outcome, paper.detail, paper.replans) == ("collision", BLOCKED, 0)
+        # the square's other three sides go round the taken cell: a navigator could have
+        # passed, so the oracle's bump (it goes straight) is a navigator error, not "blocked"
+        detour = free_path_steps((*a, heading), b, live.reachable, 12)
+        assert detour is not None and detour > 2
+        assert (paper.outcome, paper.detail, paper.replans) == ("collision", NAVIGATOR_ERROR, 0)
         ((goal, steps),) = paper.segments
         assert steps[-1].collided and steps[-1].pose[:2] == middle
 
         bumped = run_episode(episode, topo, live, localizer, None, replan=True)
         record = bumped.to_dict()
-        assert (bumped.outcome, bumped.replans, record["bumps"]) == ("success", 1, [BLOCKED])
+        assert (bumped.outcome, bumped.replans, record["bumps"]) == (
+            "success",
+            1,
+            [NAVIGATOR_ERROR],
+        )
         # the same run read under the paper's rule is the paper run
         assert bumped.paper == (paper.outcome, paper.failed_segment, paper.detail)
         # it went round: three two-cell legs after the bump, ending on b, never through middle

@@ -1,4 +1,5 @@
-"""Table II's arithmetic: Wilson intervals against published figures, rates from records."""
+"""Table II's arithmetic: Wilson intervals against published figures, intervals clustered by
+room, rates from records."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import pytest
 
 from seannet.errors import NavigationError
 from seannet.navigation.benchmark import run_labels
-from seannet.navigation.tables import case_rates, markdown, wilson
+from seannet.navigation.tables import case_rates, markdown, room_interval, wilson
 
 
 @pytest.mark.parametrize(
@@ -31,6 +32,31 @@ def test_wilson_edges() -> None:
     assert wilson(10, 10)[1] == pytest.approx(1.0) and wilson(0, 10)[0] == 0.0
     assert wilson(10, 10)[0] == pytest.approx(1 - wilson(0, 10)[1])
     assert all(math.isnan(v) for v in wilson(0, 0))
+
+
+def test_room_interval_is_clustered_and_never_narrower_than_wilson() -> None:
+    # 40 episodes, 20 successes: as independent episodes Wilson says 35..65 %
+    agree = {f"r{k}": (5, 10) for k in range(4)}
+    apart = {"r0": (10, 10), "r1": (10, 10), "r2": (0, 10), "r3": (0, 10)}
+    w_low, w_high = wilson(20, 40)
+    assert room_interval(agree) == (w_low, w_high)  # rooms that agree: Wilson's
+    low, high = room_interval(apart)  # rooms all or nothing: much wider
+    assert low < w_low - 0.1 and high > w_high + 0.1
+    assert room_interval(apart) == (low, high)  # the bootstrap's draws are seeded
+    assert room_interval({"only": (1, 4)}) == wilson(1, 4)  # one room: no spread to see
+    assert all(math.isnan(v) for v in room_interval({}))
+
+
+def test_rates_of_rooms_that_disagree_get_the_clustered_interval() -> None:
+    records = [
+        {**_record("N", "success", None, "success", None), "room_id": "a"} for _ in range(5)
+    ] + [{**_record("N", "navigation", None, "navigation", None), "room_id": "b"} for _ in range(5)]
+    success = case_rates(records, "paper")["N"]["success"]
+    assert success["count"] == 5 and success["percent"] == 50.0
+    counts = {"a": (5, 5), "b": (0, 5)}
+    assert (success["low"], success["high"]) == pytest.approx(
+        tuple(100 * v for v in room_interval(counts))
+    )
 
 
 def _record(case: str, outcome: str, detail: str | None, paper: str, paper_detail: str | None):
