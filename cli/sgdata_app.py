@@ -243,11 +243,14 @@ def render(
         bool, typer.Option(help="Draw the room's textures; --no-textures: flat colours.")
     ] = True,
 ) -> None:
-    """Render one annotated view; also writes <output>.overlay.png with boxes and relations."""
+    """Render one annotated view; also writes <output>.overlay.png with boxes and relations and
+    <output>.channels.png with the view's colourised depth, instance and class masks."""
     from PIL import Image
 
+    from sgdata.dataset.vocabulary import class_vocabulary
     from sgdata.errors import ConfigError
     from sgdata.fileio import save_png
+    from sgdata.pictures.channels import channel_strip
     from sgdata.pictures.overlay import draw_overlay
     from sgdata.pipeline.snapshot import render_snapshot
 
@@ -262,9 +265,19 @@ def render(
     overlay_path = output.with_suffix(".overlay.png")
     save_png(Image.fromarray(record.rgb), output)
     save_png(draw_overlay(record), overlay_path)
+    class_ids = {c.name: c.id for c in class_vocabulary()[1]}
+    channels_path = output.with_suffix(".channels.png")
+    strip = channel_strip(
+        record.rgb,
+        depth=record.depth,
+        instances=record.instances,
+        class_ids=np.array([class_ids[c] for c in record.obj_class], dtype=np.int64),
+    )
+    save_png(strip, channels_path)
     counts = np.bincount(record.rel_type, minlength=4) if len(record.rel_type) else [0] * 4
     console.print(
-        f"wrote {output} and {overlay_path}: {record.num_objects} visible objects, "
+        f"wrote {output}, {overlay_path} and {channels_path}: {record.num_objects} visible "
+        "objects, "
         f"relations on {counts[0]}, in {counts[1]}, proximity {counts[2]}, disjoint {counts[3]}"
     )
 

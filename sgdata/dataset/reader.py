@@ -103,7 +103,8 @@ def read_table(
                     for n in names
                 ],
                 schema=pa.schema(
-                    [expected.field(n) if n in added else table.schema.field(n) for n in names]
+                    [expected.field(n) if n in added else table.schema.field(n) for n in names],
+                    metadata=table.schema.metadata,  # the file's: name, doc, format_version
                 ),
             )
         if cast and not table.schema.equals(expected):

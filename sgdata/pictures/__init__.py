@@ -8,7 +8,11 @@ _EXPORTS = {
     "draw_layout_pair": ".preview",
     "draw_room": ".preview",
     "save_png": ".preview",
+    "channel_strip": ".channels",
+    "colour_depth": ".channels",
+    "colour_mask": ".channels",
     "bar_chart": ".report",
+    "channel_sheet": ".report",
     "contact_sheet": ".report",
     "write_report": ".report",
 }

@@ -18,7 +18,7 @@ from PIL import Image, ImageDraw, ImageFont
 
 from sgdata.dataset import Dataset
 
-__all__ = ["write_report", "bar_chart", "contact_sheet"]
+__all__ = ["write_report", "bar_chart", "channel_sheet", "contact_sheet"]
 
 EDGE_COLOURS = {0: (214, 39, 40), 1: (31, 119, 180), 2: (44, 160, 44)}  # on, in, proximity
 BAR = (70, 110, 170)
@@ -177,6 +177,34 @@ def contact_sheet(ds: Dataset, *, triplets: int = 6, seed: int = 0) -> Image.Ima
     return sheet
 
 
+def channel_sheet(ds: Dataset, *, views: int = 3) -> Image.Image | None:
+    """The first ``views`` views of the first split that stores channels, each as its strip
+    RGB | depth | instances | classes (:func:`sgdata.pictures.channels.channel_strip`); None
+    when the dataset stores no channel."""
+    from sgdata.dataset.channels import decode_channel, depth_metres
+    from sgdata.pictures.channels import channel_strip
+
+    outputs = (ds.manifest.config or {}).get("outputs") or {}
+    if not (outputs.get("depth") or outputs.get("instances")):
+        return None
+    columns = ["image", "depth", "instances", "objects"]
+    rows = ds.observations(ds.splits[0], columns=columns).slice(0, views).to_pylist()
+    strips = []
+    for row in rows:
+        with Image.open(io.BytesIO(row["image"])) as decoded:
+            rgb = np.asarray(decoded.convert("RGB"))
+        depth = None if row["depth"] is None else depth_metres(decode_channel(row["depth"]))
+        mask = None if row["instances"] is None else decode_channel(row["instances"])
+        ids = np.array([o["class_id"] for o in row["objects"]], dtype=np.int64)
+        strips.append(channel_strip(rgb, depth=depth, instances=mask, class_ids=ids))
+    if not strips:
+        return None
+    sheet = Image.new("RGB", (strips[0].width, sum(s.height + 6 for s in strips)), "white")
+    for k, strip in enumerate(strips):
+        sheet.paste(strip, (0, k * (strip.height + 6)))
+    return sheet
+
+
 def _summary(ds: Dataset, obs: dict[str, pa.Table]) -> str:
     m = ds.manifest
     lines = [
@@ -302,6 +330,10 @@ def write_report(
         written.append(out / name)
     contact_sheet(ds, triplets=triplets, seed=seed).save(out / "contact_sheet.png")
     written.append(out / "contact_sheet.png")
+    sheet = channel_sheet(ds)
+    if sheet is not None:
+        sheet.save(out / "channels.png")
+        written.append(out / "channels.png")
     (out / "summary.md").write_text(_summary(ds, obs), encoding="utf-8")
     written.append(out / "summary.md")
     return written

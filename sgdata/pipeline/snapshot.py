@@ -67,6 +67,8 @@ def render_snapshot(
             SlotTable.from_catalog(catalog),
             min_visible_pixels=min_visible_pixels,
             rules=RelationRules(),
+            keep_depth=True,  # read in the RGB pass: the channel strip costs no extra render
+            keep_instances=True,
         )
         annotator.set_layout(room, read_geometry(layout_path(room_dir, layout)), layout)
         return annotator.view(ViewPose(x, y, theta, i, j, heading))

@@ -19,6 +19,7 @@ import pytest
 from PIL import Image
 
 from sgdata.dataset import Dataset, read_manifest, write_manifest, write_parquet
+from sgdata.dataset.schema import file_schema, observations_schema, schema_at
 from sgdata.errors import DatasetError
 from sgdata.validate import ValidationReport, validate_dataset
 
@@ -73,7 +74,8 @@ def deflated_the_old_way(png: bytes) -> bytes:
 def legacy_dataset(
     root: Path, *, drop: tuple[str, ...] | list[str] = (), version: str = "1.1.0"
 ) -> None:
-    """Turn a generated dataset into one of an older format, as that sgdata wrote it: PNGs
+    """Turn a generated dataset into one of an older format, as that sgdata wrote it: without
+    the columns later minors added, PNGs
     deflated the old way and, for 1.x, images as bare bytes (non-null binary, no huggingface
     metadata), no card, no croissant.json."""
     raw = json.loads((root / "dataset.json").read_text())
@@ -86,6 +88,9 @@ def legacy_dataset(
             continue
         if entry["path"].startswith("observations/"):
             table = pq.read_table(path).drop_columns(list(drop))
+            # the columns a later minor added (the channels of 2.1.0) were not there yet
+            known = schema_at(observations_schema(), version).names
+            table = table.drop_columns([n for n in table.column_names if n not in known])
             at = table.schema.get_field_index("image")
             old = [
                 {"bytes": deflated_the_old_way(cell["bytes"]), "path": None}
@@ -94,6 +99,9 @@ def legacy_dataset(
             column = pa.array(old, type=table.schema.field(at).type)
             table = table.set_column(at, table.schema.field(at), column)
             metadata = table.schema.metadata
+            if not bare:  # the Image features of the columns that version had
+                hf = file_schema(observations_schema(), version).metadata[b"huggingface"]
+                metadata = {**metadata, b"huggingface": hf}
             if bare:
                 doc = {b"doc": table.schema.field("image").metadata[b"doc"]}
                 field = pa.field("image", pa.binary(), nullable=False, metadata=doc)
