@@ -20,7 +20,7 @@ _EXPORTS = {
     "file_entry": ".manifest",
     "read_manifest": ".manifest",
     "relation_type_names": ".manifest",
-    "write_manifest": ".manifest",
+    "write_manifest": ".publish",
     "migrate_dataset": ".migrate",
     "CARD": ".paths",
     "CROISSANT": ".paths",

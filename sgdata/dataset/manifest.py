@@ -12,19 +12,18 @@ from __future__ import annotations
 
 import json
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import jsonschema
 
 from sgdata.annotate.relations import RelationType
-from sgdata.dataset.card import write_card
-from sgdata.dataset.croissant import write_croissant
 from sgdata.dataset.paths import CARD, CROISSANT, MANIFEST, SPLITS
 from sgdata.dataset.schema import FORMAT_VERSION, manifest_json_schema, migrate_manifest_dict
+from sgdata.deprecation import moved_names
 from sgdata.errors import DatasetError
-from sgdata.fileio import atomic_write_text, sha256_file
+from sgdata.fileio import sha256_file
 
 __all__ = [
     "FORMAT_NAME",
@@ -38,11 +37,10 @@ __all__ = [
     "file_entry",
     "relation_type_names",
     "read_manifest",
-    "write_manifest",
 ]
 
 FORMAT_NAME = "sgdata"
-META_FILES = (CARD, CROISSANT)  # written by write_manifest from the manifest itself
+META_FILES = (CARD, CROISSANT)  # written by publish.write_manifest from the manifest itself
 META_SINCE = "2.0.0"  # the format version that added META_FILES
 NUM_TIERS = 5
 
@@ -360,17 +358,5 @@ def read_manifest(root: Path) -> Manifest:
     return Manifest.from_json(text, source=str(path))
 
 
-def write_manifest(manifest: Manifest, root: Path) -> Path:
-    """The last step of every writer (generate, label export and import): the dataset card
-    ``README.md`` and ``croissant.json`` from ``manifest``, then ``root/dataset.json`` listing
-    them too; each written atomically, the manifest last (no manifest = unfinished)."""
-    root = Path(root)
-    data = replace(manifest, files=tuple(f for f in manifest.files if f.path not in META_FILES))
-    write_card(root, data)
-    write_croissant(root, data)
-    files = (*data.files, *(file_entry(root, name) for name in META_FILES))
-    path = root / MANIFEST
-    atomic_write_text(
-        path, replace(data, files=tuple(sorted(files, key=lambda f: f.path))).to_json()
-    )
-    return path
+# old names, served with a DeprecationWarning for one release
+__getattr__ = moved_names(__name__, {"write_manifest": "sgdata.dataset.publish:write_manifest"})

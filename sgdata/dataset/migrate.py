@@ -20,8 +20,9 @@ import numpy as np
 import pyarrow as pa
 from PIL import Image
 
-from sgdata.dataset.manifest import FileEntry, Manifest, read_manifest, write_manifest
+from sgdata.dataset.manifest import FileEntry, Manifest, read_manifest
 from sgdata.dataset.paths import observations_path, triplets_path
+from sgdata.dataset.publish import write_manifest
 from sgdata.dataset.reader import read_table
 from sgdata.dataset.rows import PNG_STRATEGY_SINCE, encode_image, write_parquet
 from sgdata.dataset.schema import (

@@ -333,9 +333,9 @@ def _write_manifest(root, name, version, split, rooms, files, triplets, sizes, r
         Generator,
         ImageInfo,
         Manifest,
-        write_manifest,
     )
     from sgdata.dataset.paths import triplets_path
+    from sgdata.dataset.publish import write_manifest
     from sgdata.dataset.rows import triplet_table, write_parquet
     from sgdata.dataset.vocabulary import class_vocabulary
 

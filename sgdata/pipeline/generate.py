@@ -156,9 +156,9 @@ def _finish(
         ImageInfo,
         Manifest,
         file_entry,
-        write_manifest,
     )
     from sgdata.dataset.paths import obs_id, triplets_path
+    from sgdata.dataset.publish import write_manifest
     from sgdata.dataset.rows import triplet_table, write_parquet
     from sgdata.dataset.vocabulary import class_vocabulary
 

@@ -1,6 +1,6 @@
 """The house's layering (docs/architecture.md): stages import downwards only, no cycles
-(imports inside functions count), seannet reaches only the sgdata it may, and the reading
-side loads no USD, renderer or torch."""
+(imports inside functions and type-only imports count), seannet reaches only the sgdata it
+may, and the reading side loads no USD, renderer or torch."""
 
 from __future__ import annotations
 
@@ -26,7 +26,7 @@ STAGES = (
 )
 # seannet's stages from the bottom up; its top-level modules (errors, weights: plain facts)
 # sit below them all
-SEANNET_STAGES = ("data", "model", "training", "evaluation", "navigation")
+SEANNET_STAGES = ("data", "model", "training", "evaluation", "methods", "navigation")
 # The sgdata a seannet module may import: the dataset and its vocabularies (classes, relation
 # types), seeds, atomic files, errors. Only the live views (rendering a dataset's rooms again)
 # reach the generator's stages.
@@ -46,19 +46,11 @@ HEAVY = ("pxr", "pyrender", "open3d", "trimesh", "torch", "OpenGL", "sgdata.rend
 
 
 def _imports(path: Path, package: str = "sgdata") -> set[str]:
-    """Every ``package`` module a file imports, at module level or inside functions (not
-    under ``if TYPE_CHECKING:``: an annotation's import never runs)."""
+    """Every ``package`` module a file imports: at module level, inside functions and under
+    ``if TYPE_CHECKING:`` (a circle of types is still a circle for a reader)."""
     found = set()
     tree = ast.parse(path.read_text(encoding="utf-8"))
-    typing_only = {
-        id(n)
-        for block in ast.walk(tree)
-        if isinstance(block, ast.If) and ast.unparse(block.test).endswith("TYPE_CHECKING")
-        for n in ast.walk(block)
-    }
     for node in ast.walk(tree):
-        if id(node) in typing_only:
-            continue
         if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
             found.add(node.module)
         elif isinstance(node, ast.Import):

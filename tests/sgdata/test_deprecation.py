@@ -16,6 +16,7 @@ MOVED = [
     ("sgdata.seeds", "own_room_seed", "sgdata.seeds", "user_room_seed"),
     ("sgdata.dataset.rows", "sha256_file", "sgdata.fileio", "sha256_file"),
     ("sgdata.usd.stage", "write_text_atomic", "sgdata.usd.stage", "write_usd_file"),
+    ("sgdata.dataset.manifest", "write_manifest", "sgdata.dataset.publish", "write_manifest"),
 ]
 
 
