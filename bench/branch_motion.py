@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+from itertools import islice
 from pathlib import Path
 
 import torch
@@ -24,6 +25,7 @@ sys.path.insert(0, str(ROOT))
 from seannet.data.datasets import ImageTransform, TripletDataset, collate_triplets  # noqa: E402
 from seannet.model.loss import TripletLoss  # noqa: E402
 from seannet.training.config import preset  # noqa: E402
+from seannet.training.loop import train_one_epoch, triplet_step  # noqa: E402
 from seannet.training.runs import build_for_dataset  # noqa: E402
 from seannet.training.train import param_groups  # noqa: E402
 from sgdata.seeds import init_seed  # noqa: E402
@@ -61,14 +63,8 @@ def main() -> None:
     loader = DataLoader(
         data, batch_size=config.batch_size, shuffle=True, collate_fn=collate_triplets
     )
-    model.train()
-    for step, (a, p, n, _) in enumerate(loader):
-        if step == args.batches:
-            break
-        loss = loss_fn(model.embed(a), model.embed(p), model.embed(n))
-        optimizer.zero_grad()
-        loss.backward()
-        optimizer.step()
+    step = triplet_step(model, loss_fn, torch.device("cpu"))  # the step every run trains by
+    train_one_epoch(model, islice(loader, args.batches), step, optimizer)
     print(f"{'part':<18} {'relative change':>16}")
     for part, prefix in PARTS.items():
         now = dict(model.named_parameters())

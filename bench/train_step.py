@@ -40,6 +40,7 @@ from seannet.data.datasets import ImageTransform, TripletDataset, collate_triple
 from seannet.model.loss import TripletLoss  # noqa: E402
 from seannet.model.seannet import SeanNet  # noqa: E402
 from seannet.training.config import preset  # noqa: E402
+from seannet.training.loop import train_one_epoch, triplet_step  # noqa: E402
 from seannet.training.runs import build_for_dataset  # noqa: E402
 
 
@@ -81,15 +82,13 @@ def main() -> None:
         transform = ImageTransform.for_model(config.model.image_size, config.model.image_family)
         triplets = TripletDataset(args.data, "train", transform=transform, cache=True)
         loader = DataLoader(triplets, batch_size=config.batch_size, collate_fn=collate_triplets)
-        batches = [next(iter(loader))[:3]]
+        batches = [next(iter(loader))]
         optimiser = torch.optim.SGD(model.parameters(), lr=config.lr, momentum=config.momentum)
         loss_fn = TripletLoss(margin=config.margin)
+        triplets_step = triplet_step(model, loss_fn, torch.device("cpu"))
 
-        def step(model=model, batch=batches[0], optimiser=optimiser, loss_fn=loss_fn) -> None:
-            loss = loss_fn(*(model.embed(views) for views in batch))
-            optimiser.zero_grad()
-            loss.backward()
-            optimiser.step()
+        def step(model=model, batches=batches, optimiser=optimiser, step=triplets_step) -> None:
+            train_one_epoch(model, batches, step, optimiser)  # the step every run trains by
 
         figures[label] = seconds_per_call(step, args.steps)
         print(f"{label} training step, batch {config.batch_size}: {figures[label]:.3f} s")

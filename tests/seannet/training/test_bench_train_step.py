@@ -55,3 +55,34 @@ def test_profile_books_the_whole_step_to_parts(mini_dataset: Path, tmp_path: Pat
     assert by_key["fc"][4] == 6144 * 4096 + 4096 + 4096 * 2048 + 2048  # the issue's 6,144 -> ...
     assert "GCN fc 6,144 -> 4,096 -> 2,048" in out
     assert re.search(r"backward booked to a part: (9\d|100)\.\d %", out)
+
+
+def test_the_step_comparison_and_branch_motion_train_by_the_library_step(
+    mini_dataset: Path, tmp_path: Path
+) -> None:
+    """bench/train_step.py (without --profile) and bench/branch_motion.py run
+    seannet.training's own step (train_one_epoch over triplet_step) on the mini dataset."""
+    data = tmp_path / "data"
+    shutil.copytree(mini_dataset, data)
+    env = {**os.environ, "OMP_NUM_THREADS": "1"}
+    steps = subprocess.run(
+        [sys.executable, str(ROOT / "bench/train_step.py"), str(data), "--batch-size", "2",
+         "--steps", "1"],
+        capture_output=True, text=True, env=env, check=True,
+    ).stdout  # fmt: skip
+    assert "resnet18 training step, batch 2:" in steps and "seannet / resnet18 step:" in steps
+    motion = subprocess.run(
+        [sys.executable, str(ROOT / "bench/branch_motion.py"), str(data), "--batches", "1"],
+        capture_output=True, text=True, env=env, check=True,
+    ).stdout  # fmt: skip
+    moved = {
+        line[:18].strip(): float(line[18:])
+        for line in motion.splitlines()
+        if line[:18].strip() in _branch_parts()
+    }
+    assert set(moved) == set(_branch_parts()) and moved["fusion"] > 0  # one step moved it
+    assert "graph share" in motion
+
+
+def _branch_parts() -> list[str]:
+    return list(load_bench("branch_motion").PARTS)
