@@ -3,9 +3,12 @@ rooms, the test rooms read once, and intervals over rooms and seeds.
 
 The protocol (DESIGN §12), in the order it runs:
 
-1. **Budget.** Every model gets the same *seconds* of training (not the same number of
-   batches), calibrated once per trained network by timing a few steps; the batch count it
-   buys is recorded, so a rerun with the recorded figures trains exactly the same.
+1. **Budget.** Every model gets the same *seconds* of one thread's compute (not the same
+   number of batches), calibrated once per trained network by timing a few steps on one
+   thread (:mod:`seannet.training.budget`: the machine's load does not change it); what the
+   budget bought (batches, triplets, the timing's spread) is recorded in the selection, a
+   spread above :data:`~seannet.training.budget.SPREAD_WARNING` is announced as a warning,
+   and a rerun with the recorded figures trains exactly the same.
 2. **Selection, on val only.** For each learning rate of ``lrs``, seed 0 is trained and its
    best epoch (per-epoch val) is evaluated on the *whole* val split; the lr with the best val
    accuracy is chosen (ties: the smaller), and the other seeds are trained at it. A
@@ -29,20 +32,16 @@ runs are ``NAME``'s: ``resnet18``, ``resnet18+boxes`` and ``resnet18+box-kernel`
 
 from __future__ import annotations
 
-import itertools
 import json
 import math
-import time
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import torch
-from torch.utils.data import DataLoader
 
-from seannet.data.datasets import ImageTransform, TripletDataset, collate_triplets
 from seannet.errors import ModelError
 from seannet.evaluation.intervals import (
     per_room_matrix,
@@ -52,13 +51,12 @@ from seannet.evaluation.intervals import (
     welch_difference,
 )
 from seannet.evaluation.run_eval import evaluate_run
-from seannet.model.loss import TripletLoss
 from seannet.model.specs import parse_spec
+from seannet.training.budget import Calibration, calibrate
 from seannet.training.config import TrainConfig
 from seannet.training.config import preset as load_preset
-from seannet.training.loop import train_one_epoch, triplet_step
-from seannet.training.runs import LAST, build_for_dataset, device_for_run
-from seannet.training.train import param_groups, train
+from seannet.training.runs import LAST
+from seannet.training.train import train
 from sgdata.dataset import Dataset
 from sgdata.fileio import atomic_write_text
 
@@ -66,7 +64,6 @@ __all__ = [
     "COMPARISON",
     "SELECTION",
     "ModelSpec",
-    "calibrate_batches",
     "compare_models",
     "model_spec",
     "summarize",
@@ -75,7 +72,6 @@ __all__ = [
 
 COMPARISON = "comparison"  # comparison.json and comparison.md under the output directory
 SELECTION = "selection.json"  # every choice, written before any test row is read
-_CALIBRATION_STEPS = 3  # timed training steps (after one warm-up) per model
 
 
 @dataclass(frozen=True)
@@ -126,7 +122,8 @@ def compare_models(
         preset: a preset name or a :class:`TrainConfig` (its model is replaced).
         seeds: training seeds (the first one selects the lr).
         lrs: candidate learning rates, chosen per model on val (default: the preset's).
-        budget_s: training seconds per run; None keeps the preset's batch count for all.
+        budget_s: seconds of one thread's compute per run (seannet.training.budget); None
+            keeps the preset's batch count for all.
         on_selected: called with the selection file once it is written, before any test row
             is read.
         tag: names this comparison's files (``selection-<tag>.json``, ...), so comparisons of
@@ -144,16 +141,21 @@ def compare_models(
     base = load_preset(preset) if isinstance(preset, str) else preset
     specs = [model_spec(name, base) for name in models]  # refuse a bad spec before work
     batches = dict(batches or {})
+    calibrations: dict[str, Calibration] = {}
     chosen = []
     for spec in specs:
         config = spec.config
         if budget_s is not None or spec.trained in batches:
             if spec.trained not in batches:
-                batches[spec.trained] = calibrate_batches(config, data, budget_s)
-                filled = f"{batches[spec.trained]} batches per epoch fill {budget_s:.0f} s"
-                say(f"{spec.trained}: {filled}")
+                calibrations[spec.trained] = _calibrate(spec.trained, config, data, budget_s, say)
+                batches[spec.trained] = calibrations[spec.trained].batches
             config = config.replace(max_train_batches=batches[spec.trained])
-        chosen.append(_select(spec, config, data, out, seeds, lrs or (config.lr,), say))
+        choice = _select(spec, config, data, out, seeds, lrs or (config.lr,), say)
+        got = calibrations.get(spec.trained)
+        # what the budget bought and how it was measured; or where the batches came from
+        source = "recorded" if spec.trained in batches else "preset"
+        choice["budget"] = {"source": "calibrated", **got.to_dict()} if got else {"source": source}
+        chosen.append(choice)
     selection = {
         "preset": preset if isinstance(preset, str) else "custom",
         "budget_s": budget_s,
@@ -215,8 +217,34 @@ def _select(
         "val_accuracy_by_lr": {f"{k:g}": v for k, v in sweep.items()},
         "batches_per_epoch": config.max_train_batches,
         "epochs": config.epochs,
+        # triplets trained per run (0 batches: the whole split every epoch)
+        "examples": config.max_train_batches * config.batch_size * config.epochs,
         "runs": runs,
     }
+
+
+def _calibrate(
+    trained: str,
+    config: TrainConfig,
+    data: Path,
+    budget_s: float,
+    say: Callable[[str], None],
+) -> Calibration:
+    """The budget's batches for one network, announced; a disturbed timing is a warning."""
+    got = calibrate(config, data, budget_s)
+    say(
+        f"{trained}: {got.batches} batches per epoch fill {budget_s:g} s of one thread "
+        f"(a step {got.step_s:.3f} s, rounds {100 * got.spread:.0f} % apart)"
+    )
+    if got.noisy:
+        warning = (
+            f"{trained}: the calibration's rounds differ by {100 * got.spread:.0f} %: the "
+            f"machine was busy ({100 * got.busy:.0f} % of the time elsewhere); pass the "
+            "recorded batches to train the same, or calibrate again on a quieter machine"
+        )
+        warnings.warn(warning, RuntimeWarning, stacklevel=3)
+        say(f"warning: {warning}")
+    return got
 
 
 def _run_dir(out: Path, name: str, lr: float, seed: int) -> Path:
@@ -225,43 +253,6 @@ def _run_dir(out: Path, name: str, lr: float, seed: int) -> Path:
 
 def _train(config: TrainConfig, data: Path, run: Path, pretrained: Path | None) -> None:
     train(config, data, run, resume=(run / LAST).exists(), pretrained=pretrained)
-
-
-def calibrate_batches(config: TrainConfig, data: Path, budget_s: float) -> int:
-    """Batches per epoch that fill ``budget_s`` seconds of training, from timed steps.
-
-    A step is timed in CPU seconds of this process divided by torch's threads (on the GPU:
-    wall seconds): on a machine shared with other work the wall clock counts their time too,
-    and the budget would then depend on what else ran during the calibration.
-    """
-    torch.manual_seed(0)
-    device = device_for_run()
-    model = build_for_dataset(config, data).to(device)
-    optimizer = torch.optim.SGD(param_groups(model, config), lr=config.lr, momentum=0.9)
-    loss_fn = TripletLoss(margin=config.margin)
-    triplets = TripletDataset(
-        data,
-        "train",
-        transform=ImageTransform.for_model(config.model.image_size, config.model.image_family),
-    )
-    loader = DataLoader(triplets, batch_size=config.batch_size, collate_fn=collate_triplets)
-    batches = itertools.islice(loader, _CALIBRATION_STEPS + 1)
-    gpu = device.type == "cuda"
-    clock = time.perf_counter if gpu else time.process_time
-    marks: list[float] = []
-
-    def mark(_phase: str, _step: int, _total: int, _metrics: dict[str, float]) -> None:
-        if gpu:
-            torch.cuda.synchronize()  # kernels run asynchronously: time them, not their launch
-        marks.append(clock())
-
-    start = clock()
-    train_one_epoch(model, batches, triplet_step(model, loss_fn, device), optimizer, progress=mark)
-    # the first step pays for allocation; each later one from the mark before it (the
-    # loader's read of the next batch counts: a run pays for it too)
-    seconds = np.diff([start, *marks])[1:] / (1 if gpu else torch.get_num_threads())
-    per_epoch = budget_s / config.epochs
-    return max(1, int(per_epoch / float(np.median(seconds))))
 
 
 def summarize(runs: list[dict[str, Any]]) -> dict[str, Any]:
@@ -369,3 +360,18 @@ def markdown(results: dict[str, Any]) -> str:
         moved = e["summary"]["by_moved"]
         rows.append(f"| {e['model']} | " + " | ".join(_pm(moved[b]) for b in bins) + " |")
     return "\n".join(rows) + "\n"
+
+
+def __getattr__(name: str) -> Any:
+    """``calibrate_batches`` moved to :mod:`seannet.training.budget` (one release)."""
+    if name == "calibrate_batches":
+        from seannet.training import budget
+
+        warnings.warn(
+            "seannet.evaluation.compare.calibrate_batches moved to "
+            "seannet.training.budget.calibrate_batches (the old name goes in the next release)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return budget.calibrate_batches
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
