@@ -321,33 +321,34 @@ def _measure(
     ups = [source.up] if source.up != "auto" else [default_up, "z" if default_up == "y" else "y"]
     units = [source.units] if source.units != "auto" else list(_UNITS)
     lo, hi = np.log(size_min), np.log(size_max)
-    best: tuple[float, str, str, np.ndarray] | None = None
+    fit = source.scale == "fit"
+    best: tuple[tuple[float, float], str, str, np.ndarray, float] | None = None
     for up in ups:
         extent = np.ptp(_to_local(vertices, up, source.front), axis=0)
         for unit in units:
             size = np.maximum(extent * _UNITS[unit], 1e-9)
-            miss = float(
-                np.sum(np.maximum(0.0, lo - np.log(size)) + np.maximum(0.0, np.log(size) - hi))
-            )
-            if best is None or miss < best[0] - 1e-9:
-                best = (miss, up, unit, size)
+            scale = _fit_scale(size, lo, hi) if fit else 1.0
+            # fit: the proportions decide the up axis first; the unit, how far it scales
+            key = (round(_miss(size * scale, lo, hi), 9), _miss(size, lo, hi))
+            if best is None or key < best[0]:
+                best = (key, up, unit, size, scale)
     assert best is not None
-    miss, up, unit, size = best
+    (miss, raw_miss), up, unit, size, scale = best
     measured = " x ".join(f"{v:.3g}" for v in size)
     bounds = (
         f"[{', '.join(f'{v:g}' for v in size_min)}] to [{', '.join(f'{v:g}' for v in size_max)}] m"
     )
-    if source.scale == "fit":
-        # the largest uniform scale that keeps every side within its upper bound, at least
-        # the smallest that brings every side to its lower bound
-        scale = min(1.0, float(np.min(np.exp(hi) / size)))
-        scale = max(scale, float(np.max(np.exp(lo) / size))) if scale >= 1.0 else scale
-        if not 1.0 / FIT_LIMIT <= scale <= FIT_LIMIT:
-            raise CatalogError(
-                f"{file}: measures {measured} m read in {unit} ({up} up), {scale:.3g} times "
-                f"off class {class_name}'s size {bounds}; give its 'units' in the class entry"
-            )
-        return up, unit, scale
+    if miss > 3 * math.log(SIZE_TOLERANCE) and fit:
+        raise CatalogError(
+            f"{file}: measures {measured} m ({up.upper()} up); its proportions fit class "
+            f"{class_name}'s size {bounds} at no scale; give its 'up' axis in the class entry "
+            "or widen size_min/size_max"
+        )
+    if fit and not 1.0 / FIT_LIMIT <= scale <= FIT_LIMIT:
+        raise CatalogError(
+            f"{file}: measures {measured} m read in {unit} ({up.upper()} up), {scale:.3g} "
+            f"times off class {class_name}'s size {bounds}; give its 'units' in the class entry"
+        )
     if miss > 3 * math.log(SIZE_TOLERANCE):
         raw = " x ".join(f"{v:.4g}" for v in np.ptp(vertices, axis=0))
         raise CatalogError(
@@ -355,7 +356,23 @@ def _measure(
             f"it within class {class_name}'s size {bounds} (closest: {measured} m in {unit}); "
             'fix the file\'s scale, widen size_min/size_max, or set scale = "fit"'
         )
-    return up, unit, 1.0
+    return up, unit, scale
+
+
+def _miss(size: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> float:
+    """How far (summed log factors) a size lies outside the log bounds ``lo``..``hi``."""
+    logs = np.log(size)
+    return float(np.sum(np.maximum(0.0, lo - logs) + np.maximum(0.0, logs - hi)))
+
+
+def _fit_scale(size: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> float:
+    """The uniform scale nearest 1 that brings ``size`` within the bounds (the middle of what
+    the tightest sides allow when no scale does)."""
+    low = float(np.max(np.exp(lo) / size))  # smallest scale reaching every lower bound
+    high = float(np.min(np.exp(hi) / size))  # largest keeping every upper bound
+    if low <= high:
+        return min(max(1.0, low), high)
+    return math.sqrt(low * high)
 
 
 def _hull(points: np.ndarray) -> np.ndarray:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from . import (
+    surface_assets,
     surface_configs,
     surface_datasets,
     surface_label_files,
@@ -21,5 +22,6 @@ SURFACES: dict[str, Surface] = {
         surface_label_files,
         surface_label_server,
         surface_datasets,
+        surface_assets,
     )
 }

@@ -18,6 +18,7 @@ EXAMPLES = {
     "label files (COCO, LabelMe, Label Studio)": 40,
     "label server request bodies": 30,
     "datasets (Dataset.open, validate)": 12,
+    "mesh assets": 40,
 }
 
 
