@@ -12,6 +12,8 @@ from rich.console import Console
 from rich.table import Table
 from sgdata_cli.errors import run_app
 
+from sgdata.dataset.paths import MANIFEST
+
 app = typer.Typer(
     name="sgdata",
     help="Generate, validate and serve scene-graph datasets of rooms whose objects move.",
@@ -20,6 +22,7 @@ app = typer.Typer(
     add_completion=False,
 )
 console = Console()
+DATASET_ROOT = f"Dataset root (holding {MANIFEST})."  # the help of every DATASET argument
 
 
 @app.command()
@@ -242,6 +245,13 @@ def render(
     textures: Annotated[
         bool, typer.Option(help="Draw the room's textures; --no-textures: flat colours.")
     ] = True,
+    config: Annotated[
+        str | None,
+        typer.Option(
+            help="A generation config (TOML or preset) whose [camera], [poses] and [annotation] "
+            "the view follows (default: the defaults of sgdata generate)."
+        ),
+    ] = None,
 ) -> None:
     """Render one annotated view; also writes <output>.overlay.png with boxes and relations and
     <output>.channels.png with the view's colourised depth, instance and class masks."""
@@ -252,6 +262,7 @@ def render(
     from sgdata.fileio import save_png
     from sgdata.pictures.channels import channel_strip
     from sgdata.pictures.overlay import draw_overlay
+    from sgdata.pipeline.config import GenerateConfig, load_config
     from sgdata.pipeline.snapshot import render_snapshot
 
     cell, heading = None, 0
@@ -261,7 +272,17 @@ def render(
         except ValueError:
             raise ConfigError(f"--pose {pose!r}: expected I,J,H such as 4,6,1") from None
         cell = (i, j)
-    record = render_snapshot(room_dir, layout=layout, cell=cell, heading=heading, textures=textures)
+    settings = load_config(config) if config is not None else GenerateConfig()
+    record = render_snapshot(
+        room_dir,
+        layout=layout,
+        cell=cell,
+        heading=heading,
+        camera=settings.camera,
+        poses=settings.poses,
+        annotation=settings.annotation,
+        textures=textures,
+    )
     overlay_path = output.with_suffix(".overlay.png")
     save_png(Image.fromarray(record.rgb), output)
     save_png(draw_overlay(record), overlay_path)
@@ -284,7 +305,7 @@ def render(
 
 @app.command()
 def validate(
-    root: Annotated[Path, typer.Argument(help="Dataset root (holding dataset.json).")],
+    root: Annotated[Path, typer.Argument(help=DATASET_ROOT)],
     json_out: Annotated[
         bool, typer.Option("--json", help="Print the report as JSON on stdout.")
     ] = False,
@@ -325,7 +346,7 @@ def validate(
 
 @app.command()
 def migrate(
-    root: Annotated[Path, typer.Argument(help="Dataset root (holding dataset.json).")],
+    root: Annotated[Path, typer.Argument(help=DATASET_ROOT)],
 ) -> None:
     """Rewrite a format 1.x dataset in the current format, in place (card and croissant.json
     included)."""
@@ -337,7 +358,7 @@ def migrate(
 
 @app.command()
 def report(
-    root: Annotated[Path, typer.Argument(help="Dataset root (holding dataset.json).")],
+    root: Annotated[Path, typer.Argument(help=DATASET_ROOT)],
     output: Annotated[Path, typer.Option("-o", "--output", help="Directory to write into.")] = Path(
         "report"
     ),
@@ -466,7 +487,7 @@ def import_(
 @app.command(name="export")
 def export(
     fmt: Annotated[str, typer.Argument(metavar="FORMAT", help="coco | labelstudio | yolo")],
-    dataset: Annotated[Path, typer.Argument(help="Dataset root (holding dataset.json).")],
+    dataset: Annotated[Path, typer.Argument(help=DATASET_ROOT)],
     output: Annotated[
         Path,
         typer.Option(

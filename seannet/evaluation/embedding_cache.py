@@ -21,6 +21,7 @@ import numpy as np
 from seannet.data.box_noise import BoxNoise
 from seannet.evaluation.metrics import Embeddings
 from seannet.training.runs import BEST
+from sgdata.dataset.paths import MANIFEST
 from sgdata.fileio import atomic_write_bytes, sha256_file
 
 __all__ = ["CACHE_DIR", "cached_embeddings"]
@@ -40,7 +41,7 @@ def cached_embeddings(
     key = json.dumps(
         {
             "checkpoint_sha256": sha256_file(run / BEST)[0],
-            "manifest_sha256": sha256_file(data / "dataset.json")[0],
+            "manifest_sha256": sha256_file(data / MANIFEST)[0],
             "split": split,
             "noise": asdict(noise) if noise is not None and noise.active else None,
         },

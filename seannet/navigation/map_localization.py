@@ -29,6 +29,7 @@ from seannet.evaluation.retrieval import recall_at_k
 from seannet.navigation.localizer import Localizer, load_localizer
 from seannet.navigation.maps import TopoMap, check_map, load_map, map_dirs
 from seannet.training.runs import MODEL_KEYS
+from sgdata.dataset.paths import MANIFEST
 from sgdata.fileio import atomic_write_text
 
 __all__ = ["match", "localize_queries", "retrieval", "run_localize"]
@@ -202,7 +203,7 @@ def run_localize(
     paths = map_dirs(map_path)
     first = load_map(paths[0])
     source = Path(str(first.meta.get("data", "")))
-    if not (source / "dataset.json").is_file():
+    if not (source / MANIFEST).is_file():
         raise MapError(f"{paths[0]}/map.json: data {str(source)!r} is not a dataset any more")
     localizer = load_localizer(run, source, epsilon=epsilon)
     maps = _open_maps(localizer, paths)

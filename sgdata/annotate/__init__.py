@@ -5,6 +5,7 @@ from sgdata.lazy_face import lazy_face
 _EXPORTS = {
     "ViewAnnotator": ".annotator",
     "Annotation": ".boxes",
+    "MIN_VISIBLE_PIXELS": ".records",
     "ObjectTable": ".boxes",
     "annotate": ".boxes",
     "ViewPose": ".records",

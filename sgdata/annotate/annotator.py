@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from sgdata.annotate.boxes import ObjectTable, annotate
-from sgdata.annotate.records import ViewPose, ViewRecord
+from sgdata.annotate.records import MIN_VISIBLE_PIXELS, ViewPose, ViewRecord
 from sgdata.annotate.relations import RelationRules, compute_relations, stored_precision
 from sgdata.annotate.slots import SlotTable
 from sgdata.errors import RenderError
@@ -39,7 +39,7 @@ class ViewAnnotator:
         renderer: Renderer,
         slots: SlotTable,
         *,
-        min_visible_pixels: int = 20,
+        min_visible_pixels: int = MIN_VISIBLE_PIXELS,
         rules: RelationRules | None = None,
         keep_depth: bool = False,
         keep_instances: bool = False,

@@ -18,6 +18,7 @@ from functools import cache
 
 import numpy as np
 
+from sgdata.annotate.records import MIN_VISIBLE_PIXELS
 from sgdata.errors import RenderError
 from sgdata.render.renderer import RenderedView
 from sgdata.usd.meshes import SceneGeometry
@@ -128,7 +129,9 @@ class Annotation:
         return lut[self.label]
 
 
-def annotate(view: RenderedView, table: ObjectTable, *, min_visible_pixels: int = 20) -> Annotation:
+def annotate(
+    view: RenderedView, table: ObjectTable, *, min_visible_pixels: int = MIN_VISIBLE_PIXELS
+) -> Annotation:
     """Visible objects (at least ``min_visible_pixels`` pixels) with their tight pixel boxes.
 
     Raises:

@@ -10,7 +10,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["ViewPose", "ViewRecord"]
+__all__ = ["MIN_VISIBLE_PIXELS", "ViewPose", "ViewRecord"]
+
+# A view record lists the objects with at least this many visible pixels (the default of
+# [annotation] min_visible_pixels): fewer, and the object is not in the view.
+MIN_VISIBLE_PIXELS = 20
 
 
 @dataclass(frozen=True)

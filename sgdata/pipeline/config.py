@@ -23,6 +23,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any, ClassVar
 
+from sgdata.annotate.records import MIN_VISIBLE_PIXELS
 from sgdata.annotate.relations import RelationRules
 from sgdata.dataset.paths import SPLITS
 from sgdata.errors import ConfigError, SgdataError
@@ -233,7 +234,7 @@ class LayoutsConfig:
 class AnnotationConfig:
     """What counts as visible, and the relation rules."""
 
-    min_visible_pixels: int = 20
+    min_visible_pixels: int = MIN_VISIBLE_PIXELS  # fewer visible pixels: not in the view
     relations: RelationRules = field(default_factory=RelationRules)
 
     def __post_init__(self) -> None:

@@ -6,15 +6,15 @@ from pathlib import Path
 
 from sgdata.annotate.annotator import ViewAnnotator
 from sgdata.annotate.records import ViewPose, ViewRecord
-from sgdata.annotate.relations import RelationRules
 from sgdata.annotate.slots import SlotTable
 from sgdata.errors import ConfigError
+from sgdata.pipeline.config import AnnotationConfig
 from sgdata.render.camera import CameraConfig
 from sgdata.render.renderer import Renderer
 from sgdata.usd.geometry import read_geometry
 from sgdata.usd.scene_dirs import layout_path, load_layout
 from sgdata.world.catalog import Catalog, load_catalog
-from sgdata.world.poses import HEADINGS_DEG, pose_grid
+from sgdata.world.poses import HEADINGS_DEG, PosesConfig
 
 __all__ = ["render_snapshot"]
 
@@ -26,16 +26,17 @@ def render_snapshot(
     cell: tuple[int, int] | None,
     heading: int,
     camera: CameraConfig | None = None,
-    grid_cell: float = 0.25,
-    robot_radius: float = 0.2,
-    min_visible_pixels: int = 20,
+    poses: PosesConfig | None = None,
+    annotation: AnnotationConfig | None = None,
     catalog: Catalog | None = None,
     textures: bool = True,
 ) -> ViewRecord:
     """Render and annotate the view at grid ``cell`` and ``heading`` (0..3) of a layout.
 
     ``cell=None`` takes the middle one of the layout's reachable cells (in index order);
-    ``textures=False`` draws a textured room in its flat colours.
+    ``textures=False`` draws a textured room in its flat colours. ``camera``, ``poses`` and
+    ``annotation`` are a run's ``[camera]``, ``[poses]`` and ``[annotation]`` (default: the
+    defaults ``sgdata generate`` uses), so the view is the one that run would record.
 
     Raises:
         ConfigError: unknown room directory or layout, heading out of range, or a cell off the
@@ -45,7 +46,8 @@ def render_snapshot(
     if not 0 <= heading < len(HEADINGS_DEG):
         raise ConfigError(f"heading {heading}: expected 0..3 (0/90/180/270 degrees)")
     room = load_layout(room_dir, layout, catalog)
-    grid = pose_grid(room, cell=grid_cell, radius=robot_radius)
+    grid = (poses or PosesConfig()).grid(room)
+    annotation = annotation or AnnotationConfig()
     if cell is None:
         if not grid.cells:
             raise ConfigError(f"{room_dir}: layout {layout} has no reachable cell to render from")
@@ -65,8 +67,8 @@ def render_snapshot(
         annotator = ViewAnnotator(
             renderer,
             SlotTable.from_catalog(catalog),
-            min_visible_pixels=min_visible_pixels,
-            rules=RelationRules(),
+            min_visible_pixels=annotation.min_visible_pixels,
+            rules=annotation.relations,
             keep_depth=True,  # read in the RGB pass: the channel strip costs no extra render
             keep_instances=True,
         )

@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from sgdata.annotate.relations import RelationRules, compute_relations
+from sgdata.dataset.paths import MANIFEST
 from sgdata.errors import ConfigError
 from sgdata.validate.loading import Flat, SplitTables, column_numpy
 from sgdata.validate.problems import Collector
@@ -40,7 +41,7 @@ def check_recompute(
     try:
         rules = _rules(raw)
     except ConfigError as exc:
-        out.add("relations.recompute", "dataset.json", str(exc), field="relation_rules")
+        out.add("relations.recompute", MANIFEST, str(exc), field="relation_rules")
         return
     names = raw["relation_types"]
     name_of = lambda t: names[t] if 0 <= t < len(names) else str(t)  # noqa: E731
