@@ -38,7 +38,6 @@ _EXPORTS = {
     "observations_path": ".paths",
     "parse_obs_id": ".paths",
     "scene_dir": ".paths",
-    "scene_layer_path": ".paths",
     "triplets_path": ".paths",
     "Dataset": ".reader",
     "decode_image": ".reader",

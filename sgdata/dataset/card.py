@@ -45,7 +45,6 @@ __all__ = [
 DATA_LICENSE = "cc-by-4.0"
 DATA_LICENSE_URL = "https://creativecommons.org/licenses/by/4.0/"
 PAPER_URL = "https://arxiv.org/abs/2110.02276"
-CONFIGS = ("observations", "triplets")  # the card's configs, observations the default
 TASKS = ("image-feature-extraction", "object-detection")
 TAGS = ("scene-graph", "indoor", "localization", "synthetic", "sgdata", "croissant")
 # The Hugging Face Hub's size_categories tags, by number of views.

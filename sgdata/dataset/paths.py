@@ -16,7 +16,7 @@ All paths are relative to the dataset root and use ``/`` on every platform (they
 
 from __future__ import annotations
 
-from pathlib import Path, PurePosixPath
+from pathlib import Path
 from typing import NamedTuple
 
 from sgdata.errors import DatasetError
@@ -39,7 +39,6 @@ __all__ = [
     "parse_obs_id",
     "observations_path",
     "triplets_path",
-    "scene_layer_path",
     "scene_dir",
 ]
 
@@ -122,9 +121,3 @@ def scene_dir(root: Path, room_id: str) -> Path:
     """A room's scene directory under a dataset root."""
     _check_room_id(room_id)
     return root / SCENES.format(room_id=room_id)
-
-
-def scene_layer_path(room_id: str, layout: int) -> str:
-    """Relative path of a layout's USD layer (the ``scene`` column of observations)."""
-    _check_room_id(room_id)
-    return str(PurePosixPath(SCENE_LAYER.format(room_id=room_id, layout=int(layout))))
