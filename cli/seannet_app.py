@@ -407,6 +407,67 @@ def navigate(
     console.print(f"wrote {result['written']} and its .json")
 
 
+@app.command()
+def benchmark(
+    data: Data,
+    methods: Annotated[
+        str,
+        typer.Option(
+            help="Comma-separated methods: a registered name (tiny-image, lite0-gem, "
+            "boxes-overlap, boxes-kernel, an entry point of seannet.methods), an import path "
+            "pkg.module:factory or path/file.py:factory, or a model spec (resnet18+boxes)."
+        ),
+    ],
+    out: Annotated[Path, typer.Option("--out", help="Directory for the cards (one per method).")],
+    seeds: Annotated[str, typer.Option(help="Seeds of trained methods (frozen: the first).")] = (
+        "0,1,2"
+    ),
+    preset: Annotated[str, typer.Option(help=f"One of {', '.join(PRESETS)}.")] = "cpu",
+    batches: Annotated[
+        int | None, typer.Option(help="Batches per epoch for trained methods (default: preset).")
+    ] = None,
+    epochs: Annotated[
+        int | None, typer.Option(help="Epochs for trained methods (default: preset).")
+    ] = None,
+    lrs: Annotated[
+        str, typer.Option(help="Learning rates a trained method chooses from on val.")
+    ] = "",
+) -> None:
+    """DESIGN §12's protocol for any method: choices on val, test once, the change sweep, box
+    noise, cost; one card per method (JSON, markdown, sweep plot)."""
+    from seannet.methods.benchmark import BenchmarkConfig, benchmark_method
+
+    try:
+        config = BenchmarkConfig(
+            seeds=tuple(int(s) for s in seeds.split(",") if s.strip()),
+            preset=preset, batches=batches, epochs=epochs,
+            lrs=tuple(float(v) for v in lrs.split(",") if v.strip()),
+        )  # fmt: skip
+    except ValueError:
+        raise typer.BadParameter("--seeds takes integers, --lrs numbers, comma-separated") from None
+    for name in [m.strip() for m in methods.split(",") if m.strip()]:
+        card = benchmark_method(name, data, out, config, announce=console.print)
+        typer.echo(card.with_name("card.md").read_text())
+        console.print(f"wrote {card} and its .md, sweep.png")
+
+
+@app.command()
+def leaderboard(
+    cards: Annotated[list[Path], typer.Argument(help="Card directories (searched) or files.")],
+    out: Annotated[Path | None, typer.Option(help="Also write the table to this file.")] = None,
+) -> None:
+    """Merge benchmark cards into one table per dataset, with intervals."""
+    from seannet.methods.cards import leaderboard as render
+    from seannet.methods.cards import read_cards
+    from sgdata.fileio import atomic_write_text
+
+    text = render(read_cards(cards))
+    typer.echo(text)
+    if out is not None:
+        atomic_write_text(out, text)
+        console.print(f"wrote {out}")
+
+
 def _errors() -> tuple[type[Exception], ...]:
     from seannet.errors import SeannetError
 

@@ -9,6 +9,7 @@ __all__ = [
     "DataError",
     "MapError",
     "NavigationError",
+    "MethodError",
 ]
 
 
@@ -34,3 +35,8 @@ class MapError(SeannetError):
 
 class NavigationError(SeannetError):
     """A localization or navigation request cannot run: no threshold, no room, no episode."""
+
+
+class MethodError(SeannetError):
+    """A localization method (``seannet.methods``) cannot be loaded, or broke a check of the
+    interface: the message names the method and the check."""

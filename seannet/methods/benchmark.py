@@ -1,0 +1,429 @@
+"""``seannet benchmark``: DESIGN §12's protocol for any method, one card per method.
+
+For each method (a name, an import path or a model spec, :func:`load_method`) and each seed
+(trained methods: every seed of the config; frozen ones: the first):
+
+1. ``fit(train, val, budget)`` when the method has one (its choices, lr and lambda, on val);
+2. every choice of the harness on **val**: epsilon, the threshold that separates same-pose
+   from one-step pairs (max balanced accuracy);
+3. **test, read once**: triplet accuracy overall, per tier and per room; full-map recall@1/@5
+   (queries of the other layouts against the layout-0 map of their room); precision / recall
+   of ``S > epsilon``; the **change sweep** (accuracy by moved objects in view, by their share
+   of the anchor's object pixels, by their dynamics class); the box-noise sweep for a method
+   with ``uses_boxes``; the cost (ms per view embedded, bytes per map entry).
+
+Every output a method gives is checked (finite, float, one row per view, one width; a
+similarity in [-1, 1]); any failure, an exception inside the method included, is one
+:class:`~seannet.errors.MethodError` naming the method and the check, and no card is written.
+Cards are JSON + markdown + a sweep plot, stamped with the commit, the data fingerprint and
+the command (:mod:`seannet.methods.cards`).
+"""
+
+from __future__ import annotations
+
+import time
+from collections import defaultdict
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+import torch.nn.functional as F
+from torch import Tensor
+from torch.utils.data import DataLoader
+
+from seannet.data.box_noise import BoxNoise
+from seannet.data.datasets import ImageTransform, ObservationDataset, collate_views, open_dataset
+from seannet.errors import MethodError
+from seannet.evaluation.intervals import per_room_matrix, t_interval, two_level_interval
+from seannet.evaluation.retrieval import recall_at_k
+from seannet.methods.change import change_of_pairs, sweep
+from seannet.methods.registry import load_method
+from seannet.methods.views import Budget, SplitData, Views
+
+__all__ = ["BenchmarkConfig", "NOISE_LEVELS", "benchmark_method", "breaking_point", "summarize"]
+
+NOISE_LEVELS = (
+    BoxNoise(jitter=0.05),
+    BoxNoise(jitter=0.15),
+    BoxNoise(drop=0.2),
+    BoxNoise(spurious=0.2),
+    BoxNoise(jitter=0.1, drop=0.1, spurious=0.1),
+)
+_CHUNK = 4096  # pairs per similarity call
+_TOLERANCE = 1e-4  # how far past [-1, 1] a similarity may round
+
+
+@dataclass(frozen=True)
+class BenchmarkConfig:
+    """What the benchmark runs; every method of one benchmark gets the same."""
+
+    seeds: tuple[int, ...] = (0, 1, 2)  # trained methods train once per seed; frozen: the first
+    preset: str = "cpu"  # the bundled networks' training preset
+    batches: int | None = None  # batches per epoch for trained methods (None: the preset's)
+    epochs: int | None = None  # epochs for trained methods (None: the preset's)
+    lrs: tuple[float, ...] = ()  # learning rates a trained method chooses from on val
+    batch_size: int = 32  # views per embed() call
+    map_layout: int = 0  # the layout the recall maps are built in
+    noise: tuple[BoxNoise, ...] = NOISE_LEVELS  # the box-noise sweep (methods with uses_boxes)
+    extra: dict[str, Any] = field(default_factory=dict)  # recorded as given
+
+    def __post_init__(self) -> None:
+        if not self.seeds:
+            raise MethodError("benchmark: name at least one seed")
+        if self.batch_size < 1:
+            raise MethodError(f"benchmark: batch_size {self.batch_size}; expected >= 1")
+
+
+def _guarded(name: str, what: str, call: Callable[..., Any], *args: Any) -> Any:
+    """``call(*args)``, an exception inside the method becoming one line naming it."""
+    try:
+        return call(*args)
+    except MethodError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - whatever a user's method raises
+        text = " ".join(str(exc).split())[:200]
+        raise MethodError(
+            f"method {name!r}: {what} raised {type(exc).__name__}: {text} (check: no exception)"
+        ) from None
+
+
+def _checked_vectors(name: str, out: Any, n: int, width: int | None) -> Tensor:
+    if not isinstance(out, Tensor):
+        raise MethodError(
+            f"method {name!r}: embed returned {type(out).__name__}; expected a Tensor [N, D] "
+            "(check: type)"
+        )
+    if out.dim() != 2 or out.shape[0] != n or (width is not None and out.shape[1] != width):
+        want = f"[{n}, {width if width is not None else 'D'}]"
+        raise MethodError(
+            f"method {name!r}: embed returned shape {list(out.shape)} for {n} views; expected "
+            f"{want} (check: shape)"
+        )
+    if not out.is_floating_point():
+        raise MethodError(
+            f"method {name!r}: embed returned dtype {out.dtype}; expected a float tensor "
+            "(check: dtype)"
+        )
+    if not bool(torch.isfinite(out).all()):
+        raise MethodError(f"method {name!r}: embed returned NaN or inf (check: finite)")
+    return out.detach().cpu()
+
+
+@dataclass
+class _Embedded:
+    """A split's vectors with the pose metadata only the harness sees."""
+
+    vectors: Tensor
+    obs_ids: list[str]
+    room: np.ndarray
+    layout: np.ndarray
+    grid_i: np.ndarray
+    grid_j: np.ndarray
+    heading: np.ndarray
+    seconds: float
+
+    def index(self) -> dict[str, int]:
+        return {o: k for k, o in enumerate(self.obs_ids)}
+
+
+class _Harness:
+    """One method on one dataset: views in the method's transform, checked outputs."""
+
+    def __init__(self, name: str, method: Any, data: Path, config: BenchmarkConfig) -> None:
+        self.name, self.method, self.data, self.config = name, method, data, config
+        self.width: int | None = None
+        self.similarity = getattr(method, "similarity", None)
+
+    def transform(self) -> ImageTransform:
+        size = int(getattr(self.method, "image_size", 224))
+        return ImageTransform.for_model(size, str(getattr(self.method, "network", "resnet")))
+
+    def loader(self, split: str, noise: BoxNoise | None = None) -> DataLoader:
+        views = ObservationDataset(self.data, split, transform=self.transform(), noise=noise)
+        return DataLoader(views, batch_size=self.config.batch_size, collate_fn=collate_views)
+
+    def embed(self, split: str, noise: BoxNoise | None = None) -> _Embedded:
+        parts, meta = [], defaultdict(list)
+        seconds = 0.0
+        for batch, info in self.loader(split, noise):
+            start = time.perf_counter()
+            out = _guarded(self.name, "embed", self.method.embed, Views(batch, method=self.name))
+            seconds += time.perf_counter() - start
+            out = _checked_vectors(self.name, out, batch.num_views, self.width)
+            self.width = out.shape[1]
+            parts.append(out)
+            meta["obs_id"] += info["obs_id"]
+            meta["room"] += info["room_id"]
+            for key in ("layout", "grid_i", "grid_j", "heading"):
+                meta[key] += info[key].tolist()
+        if not parts:
+            raise MethodError(f"method {self.name!r}: the {split} split holds no views")
+        return _Embedded(
+            torch.cat(parts), meta["obs_id"], np.array(meta["room"]),
+            *(np.array(meta[k]) for k in ("layout", "grid_i", "grid_j", "heading")), seconds,
+        )  # fmt: skip
+
+    def split_data(self, split: str) -> SplitData:
+        views = ObservationDataset(self.data, split)
+        index = {o: k for k, o in enumerate(views.obs_ids)}
+        table = open_dataset(self.data).triplets(split)
+        triplets = np.array(
+            [[index[o] for o in row] for row in zip(
+                *(table.column(c).to_pylist() for c in ("anchor", "positive", "negative")),
+                strict=True)],
+            dtype=np.int64,
+        ).reshape(-1, 3)  # fmt: skip
+
+        def batches(batch_size: int):  # noqa: ANN202
+            loader = DataLoader(
+                ObservationDataset(self.data, split, transform=self.transform()),
+                batch_size=batch_size, collate_fn=collate_views,
+            )  # fmt: skip
+            return (batch for batch, _ in loader)
+
+        tiers = table.column("tier").to_numpy().astype(np.int64)
+        return SplitData(split, self.data, triplets, tiers, len(views), batches, self.name)
+
+    def scores(self, vectors: Tensor, first: np.ndarray, second: np.ndarray) -> np.ndarray:
+        """(P,) similarity of the row pairs, checked."""
+        if len(first) == 0:
+            return np.zeros(0)
+        if self.similarity is None:
+            unit = F.normalize(vectors.float(), dim=1)
+            a, b = unit[torch.from_numpy(first)], unit[torch.from_numpy(second)]
+            return (a * b).sum(1).double().numpy()
+        out = []
+        for start in range(0, len(first), _CHUNK):
+            a = vectors[torch.from_numpy(first[start : start + _CHUNK])]
+            b = vectors[torch.from_numpy(second[start : start + _CHUNK])]
+            s = _guarded(self.name, "similarity", self.similarity, a, b)
+            if not isinstance(s, Tensor) or tuple(s.shape) != (len(a),):
+                shape = list(s.shape) if isinstance(s, Tensor) else type(s).__name__
+                raise MethodError(
+                    f"method {self.name!r}: similarity returned {shape} for {len(a)} pairs; "
+                    f"expected a Tensor [{len(a)}] (check: similarity shape)"
+                )
+            s = s.detach().double().cpu()
+            if not bool(torch.isfinite(s).all()):
+                raise MethodError(
+                    f"method {self.name!r}: similarity returned NaN or inf (check: finite)"
+                )
+            if float(s.abs().max()) > 1.0 + _TOLERANCE:
+                raise MethodError(
+                    f"method {self.name!r}: similarity {float(s.abs().max()):.4g} outside "
+                    "[-1, 1], where epsilon and lambda assume a cosine (check: similarity range)"
+                )
+            out.append(s.numpy())
+        return np.concatenate(out)
+
+
+def _pose_pairs(e: _Embedded) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(first, second, steps) of same-room, same-heading view pairs at most one step apart."""
+    first, second, steps = [], [], []
+    for room in sorted(set(e.room)):
+        for heading in sorted(set(e.heading[e.room == room])):
+            k = np.nonzero((e.room == room) & (e.heading == heading))[0]
+            a, b = np.triu_indices(len(k), 1)
+            a, b = k[a], k[b]
+            step = np.abs(e.grid_i[a] - e.grid_i[b]) + np.abs(e.grid_j[a] - e.grid_j[b])
+            keep = (step <= 1) & ((step == 1) | (e.layout[a] != e.layout[b]))
+            first.append(a[keep])
+            second.append(b[keep])
+            steps.append(step[keep])
+    cat = lambda parts: np.concatenate(parts) if parts else np.zeros(0, np.int64)  # noqa: E731
+    return cat(first), cat(second), cat(steps)
+
+
+def _choose_epsilon(same: np.ndarray, step: np.ndarray) -> dict[str, float]:
+    """Epsilon maximising balanced accuracy of same-pose vs one-step pairs (val)."""
+    if not len(same) or not len(step):
+        return {"epsilon": float("nan"), "balanced_accuracy": float("nan")}
+    candidates = np.unique(np.concatenate([same, step]))
+    balanced = [0.5 * ((same > c).mean() + (step <= c).mean()) for c in candidates]
+    best = int(np.argmax(balanced))
+    return {"epsilon": float(candidates[best]), "balanced_accuracy": float(balanced[best])}
+
+
+def _recall(h: _Harness, e: _Embedded, map_layout: int) -> dict[str, Any]:
+    """recall@1 / @5 of the same pose among the room's map-layout views (other layouts ask)."""
+    hits: dict[int, list[float]] = {1: [], 5: []}
+    for room in sorted(set(e.room)):
+        in_room = e.room == room
+        map_idx = np.nonzero(in_room & (e.layout == map_layout))[0]
+        pose_of = {(e.grid_i[k], e.grid_j[k], e.heading[k]): n for n, k in enumerate(map_idx)}
+        queries = [
+            (k, pose_of[(e.grid_i[k], e.grid_j[k], e.heading[k])])
+            for k in np.nonzero(in_room & (e.layout != map_layout))[0]
+            if (e.grid_i[k], e.grid_j[k], e.heading[k]) in pose_of
+        ]
+        if not queries:
+            continue
+        q = np.array([k for k, _ in queries])
+        first, second = np.repeat(q, len(map_idx)), np.tile(map_idx, len(q))
+        sim = h.scores(e.vectors, first, second).reshape(len(q), len(map_idx))
+        for k, value in recall_at_k(sim, np.array([t for _, t in queries])).items():
+            hits[k] += [value] * len(q)
+    return {
+        "recall": {k: float(np.mean(v)) if v else float("nan") for k, v in hits.items()},
+        "queries": len(hits[1]),
+    }
+
+
+def _triplets(h: _Harness, e: _Embedded, split: str) -> tuple[np.ndarray, dict[str, Any]]:
+    """Per-triplet correctness on ``split`` and the accuracy overall / per tier / per room."""
+    table = open_dataset(h.data).triplets(split)
+    index = e.index()
+    cols = [table.column(c).to_pylist() for c in ("anchor", "positive", "negative")]
+    a, p, n = (np.array([index[o] for o in col], dtype=np.int64) for col in cols)
+    correct = h.scores(e.vectors, a, p) > h.scores(e.vectors, a, n)
+    rooms = np.array(table.column("room_id").to_pylist())
+    tiers = table.column("tier").to_numpy()
+    result = {
+        "triplets": int(len(correct)),
+        "accuracy": float(correct.mean()) if len(correct) else float("nan"),
+        "per_tier": {str(int(t)): float(correct[tiers == t].mean()) for t in sorted(set(tiers))},
+        "per_room": {str(r): float(correct[rooms == r].mean()) for r in sorted(set(rooms))},
+        "room_triplets": {str(r): int((rooms == r).sum()) for r in sorted(set(rooms))},
+    }
+    pairs = list(zip(cols[0], cols[1], strict=True))
+    return correct, {**result, "_pairs": pairs}
+
+
+def _one_seed(
+    name: str, factory: Callable[[], Any], data: Path, config: BenchmarkConfig, seed: int,
+    work: Path, say: Callable[[str], None],
+) -> dict[str, Any]:  # fmt: skip
+    torch.manual_seed(seed)
+    method = _guarded(name, "its factory", factory)
+    if not callable(getattr(method, "embed", None)):
+        raise MethodError(f"method {name!r}: has no embed(views) (check: interface)")
+    h = _Harness(name, method, data, config)
+    fit = getattr(method, "fit", None)
+    if fit is not None:
+        say(f"{name}: fit, seed {seed}")
+        budget = Budget(seed=seed, preset=config.preset, batches=config.batches,
+                        epochs=config.epochs, lrs=config.lrs, work=work)  # fmt: skip
+        _guarded(name, "fit", fit, h.split_data("train"), h.split_data("val"), budget)
+    say(f"{name}: val (epsilon), seed {seed}")
+    val = h.embed("val")
+    first, second, steps = _pose_pairs(val)
+    s = h.scores(val.vectors, first, second)
+    threshold = _choose_epsilon(s[steps == 0], s[steps == 1])
+    say(f"{name}: test, seed {seed}")
+    test = h.embed("test")
+    correct, metrics = _triplets(h, test, "test")
+    pairs = metrics.pop("_pairs")
+    first, second, steps = _pose_pairs(test)
+    s = h.scores(test.vectors, first, second)
+    eps = threshold["epsilon"]
+    same, step = s[steps == 0], s[steps == 1]
+    positives = float((same > eps).sum() + (step > eps).sum())
+    result: dict[str, Any] = {
+        "seed": seed,
+        "trained": fit is not None,
+        **metrics,
+        "threshold": {**threshold, "rule": "max balanced accuracy, same pose vs one step (val)"},
+        "threshold_on_test": {
+            "precision": float((same > eps).sum()) / positives if positives else float("nan"),
+            "recall": float((same > eps).mean()) if len(same) else float("nan"),
+        },
+        "retrieval": _recall(h, test, config.map_layout),
+        "change": sweep(correct, change_of_pairs(open_dataset(data), "test", pairs)),
+        "cost": {
+            "ms_per_view": 1000.0 * test.seconds / len(test.obs_ids),
+            "bytes_per_map_entry": int(test.vectors.shape[1] * test.vectors.element_size()),
+            "dim": int(test.vectors.shape[1]),
+            "torch_threads": torch.get_num_threads(),
+        },
+        "choices": dict(getattr(method, "choices", {}) or {}),
+    }
+    if getattr(method, "uses_boxes", False):
+        result["box_noise"] = []
+        for noise in config.noise:
+            say(f"{name}: test under box noise {noise.label()}, seed {seed}")
+            noisy = h.embed("test", noise)
+            right, _ = _triplets(h, noisy, "test")
+            result["box_noise"].append({**asdict(noise), "label": noise.label(),
+                                        "accuracy": float(right.mean())})  # fmt: skip
+    return result
+
+
+def breaking_point(by_bin: dict[str, dict[str, float]]) -> str | None:
+    """The first bin where accuracy falls below halfway from its first bin's accuracy to
+    chance (0.5): where the method breaks; None if it never does."""
+    bins = [(k, v["accuracy"]) for k, v in by_bin.items() if not np.isnan(v["accuracy"])]
+    if not bins:
+        return None
+    line = 0.5 * (bins[0][1] + 0.5)
+    return next((k for k, acc in bins[1:] if acc < line), None)
+
+
+def _mean_bins(runs: list[dict[str, Any]], measure: str) -> dict[str, dict[str, float]]:
+    first = runs[0]["change"][measure]
+    return {
+        b: {
+            "triplets": first[b]["triplets"],
+            "accuracy": float(np.mean([r["change"][measure][b]["accuracy"] for r in runs])),
+        }
+        for b in first
+    }
+
+
+def summarize(runs: list[dict[str, Any]]) -> dict[str, Any]:
+    """Over seeds: t-intervals, the two-level (rooms x seeds) interval of accuracy, the
+    sweep's means and the breaking point."""
+    rooms = sorted(runs[0]["per_room"])
+    weight = np.array([runs[0]["room_triplets"][r] for r in rooms], dtype=np.float64)
+    change = {m: _mean_bins(runs, m) for m in runs[0]["change"]}
+    summary: dict[str, Any] = {
+        "seeds": len(runs),
+        "accuracy": t_interval([r["accuracy"] for r in runs]),
+        "accuracy_rooms_seeds": two_level_interval(per_room_matrix(runs, rooms), weight),
+        "recall1": t_interval([r["retrieval"]["recall"][1] for r in runs]),
+        "recall5": t_interval([r["retrieval"]["recall"][5] for r in runs]),
+        "epsilon": float(np.mean([r["threshold"]["epsilon"] for r in runs])),
+        "per_tier": {
+            t: float(np.mean([r["per_tier"][t] for r in runs])) for t in runs[0]["per_tier"]
+        },  # fmt: skip
+        "change": change,
+        "breaks_at": {m: breaking_point(v) for m, v in change.items() if m != "moved_dynamics"},
+        "ms_per_view": float(np.mean([r["cost"]["ms_per_view"] for r in runs])),
+        "bytes_per_map_entry": runs[0]["cost"]["bytes_per_map_entry"],
+        "triplets": runs[0]["triplets"],
+        "queries": runs[0]["retrieval"]["queries"],
+    }
+    if "box_noise" in runs[0]:
+        summary["box_noise"] = [
+            {**level, "accuracy": float(np.mean([r["box_noise"][k]["accuracy"] for r in runs]))}
+            for k, level in enumerate(runs[0]["box_noise"])
+        ]
+    return summary
+
+
+def benchmark_method(
+    name: str,
+    data: Path,
+    out: Path,
+    config: BenchmarkConfig = BenchmarkConfig(),
+    *,
+    announce: Callable[[str], None] | None = None,
+) -> Path:
+    """Run the protocol for one method and write its card under ``out``; the card's JSON path.
+
+    Raises:
+        MethodError: the method cannot be loaded or broke a check (no card is written).
+    """
+    from seannet.methods.cards import card_dir, write_card
+
+    say = announce or (lambda _text: None)
+    factory, _ = load_method(name)
+    work = out / "runs"
+    runs = [_one_seed(name, factory, data, config, config.seeds[0], work, say)]
+    trained = runs[0]["trained"]  # a method with fit() trains once per seed
+    if trained:
+        runs += [_one_seed(name, factory, data, config, s, work, say) for s in config.seeds[1:]]
+    return write_card(card_dir(out, name), name, data, config, runs, summarize(runs),
+                      trained=trained)  # fmt: skip

@@ -1,0 +1,137 @@
+"""The bundled networks as methods: a model spec (``seannet``, ``resnet18+boxes``,
+``seannet@lite0+imagenet``, ...) trained with the project's trainer, through the same
+interface as any user's method."""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import torch
+import torch.nn.functional as F
+from torch import Tensor
+
+from seannet.evaluation.box_kernel import BoxKernel
+from seannet.evaluation.box_overlap import choose_box_weight
+from seannet.evaluation.compare import model_spec
+from seannet.methods.boxes import box_scores, box_vectors, fit_kernel, triplet_box_scores
+from seannet.methods.views import Budget, SplitData, Views
+from seannet.model.specs import SEANNET, parse_spec
+from seannet.training.config import preset as load_preset
+from seannet.training.runs import LAST, restore_run
+from seannet.training.train import train
+
+__all__ = ["NetworkMethod", "embed_split_views", "pair_scores"]
+
+
+def embed_split_views(method: object, split: SplitData, batch_size: int = 32) -> Tensor:
+    """(N, D) the method's vectors of every view of ``split``, in order."""
+    parts = [method.embed(v).detach().cpu() for v in split.views(batch_size)]  # type: ignore[attr-defined]
+    return torch.cat(parts) if parts else torch.zeros(0)
+
+
+def pair_scores(method: object, vectors: Tensor, triplets: np.ndarray) -> tuple[Tensor, Tensor]:
+    """(S(A, P), S(A, N)) of triplets with the method's similarity (default cosine)."""
+    a, p, n = (vectors[torch.from_numpy(triplets[:, k])] for k in range(3))
+    score = getattr(method, "similarity", None)
+    if score is None:
+        a, p, n = (F.normalize(x.float(), dim=1) for x in (a, p, n))
+        return (a * p).sum(1), (a * n).sum(1)
+    return score(a, p), score(a, n)
+
+
+class NetworkMethod:
+    """A bundled network named by a model spec, trained by :func:`seannet.training.train` in
+    ``fit`` (the lr chosen on val among ``budget.lrs``; ``+boxes`` / ``+box-kernel``: lambda
+    chosen on val). Its vectors are the unit embedding, followed for a scene term by every
+    slot's box (the map holds them too: they count in its bytes per entry)."""
+
+    trainable = True
+
+    def __init__(self, spec: str, *, preset: str = "cpu") -> None:
+        self.parsed = parse_spec(spec)
+        self.name = spec
+        self.uses_boxes = bool(self.parsed.scene) or (
+            self.parsed.name.startswith(SEANNET) and self.parsed.name != "seannet-image"
+        )
+        self._configure(preset)
+        self.model: torch.nn.Module | None = None
+        self.device = torch.device("cpu")
+        self.box_weight = 0.0
+        self.kernel: BoxKernel | None = None
+        self.choices: dict[str, object] = {}
+        self._dim = 0
+
+    def _configure(self, preset: str, **changes: object) -> None:
+        self.config = model_spec(self.name, load_preset(preset).replace(**changes)).config
+        self.image_size = self.config.model.image_size
+        self.network = self.config.model.image_family
+
+    def fit(self, train_split: SplitData, val: SplitData, budget: Budget) -> None:
+        """Train at each lr of the budget (default: the preset's), keep the best on val."""
+        changes: dict[str, object] = {"seed": budget.seed}
+        if budget.epochs:
+            changes["epochs"] = budget.epochs
+        if budget.batches:
+            changes["max_train_batches"] = budget.batches
+        self._configure(budget.preset, **changes)
+        spec = model_spec(self.name, self.config)
+        work = budget.work or Path(tempfile.mkdtemp(prefix="seannet-method-"))
+        by_lr: dict[str, float] = {}
+        best: tuple[float, float, Path] | None = None
+        for lr in budget.lrs or (self.config.lr,):
+            run = work / spec.trained / f"lr{lr:g}" / f"seed{budget.seed}"
+            config = self.config.replace(lr=lr)
+            train(config, train_split.root, run, resume=(run / LAST).exists(),
+                  pretrained=spec.pretrained)  # fmt: skip
+            self._restore(run, train_split.root)
+            vectors = embed_split_views(self, val)
+            s_ap, s_an = pair_scores(self, vectors, val.triplets)
+            by_lr[f"{lr:g}"] = float((s_ap > s_an).float().mean())
+            if best is None or (by_lr[f"{lr:g}"], -lr) > best[:2]:
+                best = (by_lr[f"{lr:g}"], -lr, run)
+        assert best is not None
+        self._restore(best[2], train_split.root)
+        self.choices = {"lr": -best[1], "val_accuracy_by_lr": by_lr, "run": str(best[2])}
+        if self.parsed.scene == "+box-kernel":
+            self.kernel, accuracy = fit_kernel(self._boxes(train_split), train_split.triplets)
+            self.choices["box_kernel_train_accuracy"] = accuracy
+        if self.parsed.scene:
+            self._choose_weight(val)
+
+    def _restore(self, run: Path, root: Path) -> None:
+        restored = restore_run(run, root)
+        self.model, self.device = restored.model, restored.device
+
+    def _boxes(self, split: SplitData) -> Tensor:
+        return torch.cat([box_vectors(v.slot_boxes()) for v in split.views()])
+
+    def _choose_weight(self, val: SplitData) -> None:
+        vectors = embed_split_views(self, val)
+        a, p, n = (vectors[torch.from_numpy(val.triplets[:, k]), : self._dim] for k in range(3))
+        s_ap, s_an = (a * p).sum(1).double().numpy(), (a * n).sum(1).double().numpy()
+        b_ap, b_an = triplet_box_scores(vectors[:, self._dim :], val.triplets, self.kernel)
+        self.box_weight, by_weight = choose_box_weight(s_ap, s_an, b_ap, b_an)
+        self.choices["box_weight"] = {
+            "lambda": self.box_weight,
+            "val_accuracy_by_lambda": by_weight,
+        }
+
+    @torch.no_grad()
+    def embed(self, views: Views) -> Tensor:
+        if self.model is None:
+            raise RuntimeError(f"{self.name}: fit() first (a bundled network is trained)")
+        unit = F.normalize(self.model.embed(views.batch.to(self.device)), dim=1).cpu()
+        self._dim = unit.shape[1]  # where the boxes start (SeanNet's vector: fused + layout)
+        if not self.parsed.scene:
+            return unit
+        return torch.cat([unit, box_vectors(views.slot_boxes())], dim=1)
+
+    def similarity(self, a: Tensor, b: Tensor) -> Tensor:
+        d = self._dim
+        s = (a[:, :d] * b[:, :d]).sum(1)
+        if not self.parsed.scene:
+            return s
+        boxes = box_scores(a[:, d:], b[:, d:], self.kernel).to(s.dtype)
+        return (s + self.box_weight * boxes) / (1.0 + self.box_weight)  # stays in [-1, 1]

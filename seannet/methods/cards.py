@@ -1,0 +1,180 @@
+"""Benchmark cards (one per method: ``card.json``, ``card.md``, ``sweep.png``) and the
+leaderboard that merges them (``seannet leaderboard DIR...``).
+
+A card is stamped with the commit, the data fingerprint (manifest sha256) and the command
+(:mod:`seannet.provenance`); the leaderboard never mixes cards of different data in one table.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from dataclasses import asdict
+from pathlib import Path
+from typing import Any
+
+from PIL import Image, ImageDraw, ImageFont
+
+from seannet.errors import MethodError
+from seannet.markdown import pct, table
+from seannet.provenance import provenance_record, stamp
+from sgdata.fileio import atomic_write_text, save_png
+
+__all__ = ["CARD", "card_dir", "leaderboard", "read_cards", "write_card"]
+
+CARD = "card.json"  # with card.md and sweep.png beside it
+_SAFE = re.compile(r"[^A-Za-z0-9_.+@-]+")
+
+
+def card_dir(out: Path, name: str) -> Path:
+    """Where the card of method ``name`` goes under ``out`` (an import path made a file name:
+    ``path/file.py:make`` -> ``file.py__make``)."""
+    where, colon, attr = name.rpartition(":")
+    if colon and where.endswith(".py"):
+        name = f"{Path(where).name}:{attr}"
+    return out / _SAFE.sub("_", name.replace(":", "__")).strip("_")
+
+
+def _interval(entry: dict[str, float]) -> str:
+    if "low" in entry:
+        return f"{pct(entry['mean'])} [{pct(entry['low'])}, {pct(entry['high'])}]"
+    half = entry.get("ci95", float("nan"))
+    return pct(entry["mean"]) + (f" ± {pct(half)}" if not math.isnan(half) else "")
+
+
+def _markdown(card: dict[str, Any]) -> str:
+    s = card["summary"]
+    kind = f"trained, {s['seeds']} seeds" if card["trained"] else "no training"
+    lines = [
+        f"# Benchmark card: {card['method']}",
+        "",
+        stamp([card["provenance"]]),
+        "",
+        f"- {kind}; test read once; every choice on val (epsilon {s['epsilon']:.3f})",
+        f"- triplet accuracy: **{_interval(s['accuracy_rooms_seeds'])} %** (rooms x seeds, "
+        f"95 %) over {s['triplets']} test triplets",
+        f"- recall@1 / @5 in the full layout-0 map: {_interval(s['recall1'])} / "
+        f"{_interval(s['recall5'])} % over {s['queries']} queries",
+        f"- cost: {s['ms_per_view']:.2f} ms per view embedded, {s['bytes_per_map_entry']} bytes "
+        "per map entry",
+        "- breaks at (first bin below halfway from its no-change accuracy to chance): "
+        + ", ".join(f"{m.replace('_', ' ')} {b or 'never'}" for m, b in s["breaks_at"].items()),
+        "",
+        "Accuracy per tier (%):",
+        "",
+        *table(list(s["per_tier"]), [[pct(v) for v in s["per_tier"].values()]]),
+    ]
+    for measure, bins in s["change"].items():
+        lines += ["", f"The change sweep, {measure.replace('_', ' ')} (accuracy %, triplets):", ""]
+        lines += table(
+            list(bins), [[f"{pct(v['accuracy'])} ({v['triplets']})" for v in bins.values()]]
+        )
+    if "box_noise" in s:
+        lines += ["", "Box noise (S jitter, P drop, Q spurious; accuracy %):", ""]
+        lines += table(
+            ["noise", "accuracy"], [[n["label"], pct(n["accuracy"])] for n in s["box_noise"]]
+        )
+    return "\n".join(lines) + "\n"
+
+
+def _plot(card: dict[str, Any]) -> Image.Image:
+    """The change sweep as three small bar panels (accuracy per bin, 0.5 = chance)."""
+    change = card["summary"]["change"]
+    font = ImageFont.load_default(size=11)
+    width, height, pad = 240, 180, 30
+    image = Image.new("RGB", (pad + len(change) * (width + pad), height + 3 * pad), "white")
+    draw = ImageDraw.Draw(image)
+    draw.text((pad, 6), f"{card['method']}: accuracy by change", fill="black", font=font)
+    for k, (measure, bins) in enumerate(change.items()):
+        x0, y0 = pad + k * (width + pad), 2 * pad
+        draw.rectangle([x0, y0, x0 + width, y0 + height], outline="black")
+        chance = y0 + height * 0.5
+        draw.line([x0, chance, x0 + width, chance], fill=(200, 200, 200))
+        step = width / max(len(bins), 1)
+        for j, (name, value) in enumerate(bins.items()):
+            acc = value["accuracy"]
+            left = x0 + j * step + 4
+            if not math.isnan(acc):
+                top = y0 + height * (1 - acc)
+                draw.rectangle([left, top, left + step - 8, y0 + height], fill=(70, 110, 200))
+            draw.text((left, y0 + height + 4), name, fill="black", font=font)
+        draw.text((x0, y0 - 16), measure.replace("_", " "), fill="black", font=font)
+    return image
+
+
+def write_card(
+    directory: Path,
+    name: str,
+    data: Path,
+    config: Any,
+    runs: list[dict[str, Any]],
+    summary: dict[str, Any],
+    *,
+    trained: bool,
+) -> Path:
+    """Write ``card.json``, ``card.md`` and ``sweep.png`` (each atomically); the JSON path."""
+    card = {
+        "card": 1,
+        "method": name,
+        "trained": trained,
+        "provenance": provenance_record(data, step="benchmark"),
+        "config": {k: v for k, v in asdict(config).items() if k != "noise"}
+        | {"noise": [n.label() for n in config.noise]},
+        "summary": summary,
+        "runs": runs,
+    }
+    directory.mkdir(parents=True, exist_ok=True)
+    save_png(_plot(card), directory / "sweep.png")
+    atomic_write_text(directory / "card.md", _markdown(card))
+    atomic_write_text(directory / CARD, json.dumps(card, indent=2, default=str))
+    return directory / CARD
+
+
+def read_cards(paths: list[Path]) -> list[dict[str, Any]]:
+    """Every card under the given directories (or card files), sorted by method.
+
+    Raises:
+        MethodError: a path holds no card, or a card is not JSON.
+    """
+    files: list[Path] = []
+    for path in paths:
+        found = [path] if path.is_file() else sorted(path.rglob(CARD))
+        if not found:
+            raise MethodError(f"leaderboard: {path} holds no {CARD}; run seannet benchmark first")
+        files += found
+    cards = []
+    for f in files:
+        try:
+            cards.append(json.loads(f.read_text()))
+        except (OSError, ValueError) as exc:
+            raise MethodError(f"leaderboard: {f}: not a card ({exc})") from None
+    return sorted(cards, key=lambda c: c["method"])
+
+
+def leaderboard(cards: list[dict[str, Any]]) -> str:
+    """One markdown table per dataset fingerprint, best accuracy first, with intervals."""
+    by_data: dict[str, list[dict[str, Any]]] = {}
+    for card in cards:
+        by_data.setdefault(card["provenance"].get("manifest_sha256", "?"), []).append(card)
+    lines = ["# Leaderboard", ""]
+    header = ["method", "seeds", "accuracy % (rooms x seeds, 95 %)", "recall@1 %", "recall@5 %",
+              "breaks at (moved objects)", "ms / view", "bytes / entry"]  # fmt: skip
+    for fingerprint, group in by_data.items():
+        group.sort(key=lambda c: -c["summary"]["accuracy"]["mean"])
+        rows = [
+            [
+                f"`{c['method']}`",
+                str(c["summary"]["seeds"]) if c["trained"] else "- (no training)",
+                _interval(c["summary"]["accuracy_rooms_seeds"]),
+                _interval(c["summary"]["recall1"]),
+                _interval(c["summary"]["recall5"]),
+                c["summary"]["breaks_at"].get("moved_objects") or "never",
+                f"{c['summary']['ms_per_view']:.2f}",
+                str(c["summary"]["bytes_per_map_entry"]),
+            ]
+            for c in group
+        ]
+        lines += [f"Data: manifest sha256 `{fingerprint[:16]}…`", "", *table(header, rows), ""]
+        lines += [stamp([c["provenance"] for c in group]), ""]
+    return "\n".join(lines)

@@ -1,0 +1,141 @@
+"""The method interface (:class:`Method`) and the one registry of methods: a decorator, an
+import path ``package.module:factory`` (or ``path/file.py:factory``) and the entry-point group
+``seannet.methods``; a model spec of :mod:`seannet.model.specs` names a bundled network."""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import sys
+from collections.abc import Callable
+from importlib.metadata import entry_points
+from pathlib import Path
+from typing import Any, Protocol, runtime_checkable
+
+from torch import Tensor
+
+from seannet.errors import MethodError, ModelError
+
+__all__ = [
+    "ENTRY_POINT_GROUP",
+    "Method",
+    "load_method",
+    "method_names",
+    "register_method",
+]
+
+ENTRY_POINT_GROUP = "seannet.methods"
+_REGISTERED: dict[str, Callable[[], Any]] = {}
+
+
+@runtime_checkable
+class Method(Protocol):
+    """A localization method: views in, one vector per view out.
+
+    Required:
+        ``embed(views) -> Tensor[N, D]``: float vectors, finite, one row per view of the
+        :class:`~seannet.methods.views.Views` batch (images, visible objects' boxes, classes,
+        slots, relations; never the pose).
+
+    Optional attributes and methods (the harness reads them with ``getattr``):
+        ``similarity(a, b) -> Tensor[P]``: the similarity of the row pairs (a[k], b[k]), in
+            [-1, 1] (default: cosine);
+        ``fit(train, val, budget)``: train on :class:`~seannet.methods.views.SplitData`
+            ``train``, make every choice on ``val``; called once per seed;
+        ``uses_boxes`` (bool): the box-noise sweep applies;
+        ``image_size`` (int, default 224) and ``network`` (a registry network whose input
+            normalisation ``views.normalised`` uses; default ImageNet statistics).
+    """
+
+    def embed(self, views: Any) -> Tensor: ...
+
+
+def register_method(name: str) -> Callable[[Callable[[], Any]], Callable[[], Any]]:
+    """Decorator: register a factory (a class or a function of no arguments) under ``name``.
+
+    Raises:
+        MethodError: ``name`` is taken by another factory, or is a bundled model name.
+    """
+    from seannet.model.specs import MODEL_NAMES
+
+    def decorate(factory: Callable[[], Any]) -> Callable[[], Any]:
+        if name in MODEL_NAMES or (name in _REGISTERED and _REGISTERED[name] is not factory):
+            raise MethodError(f"method {name!r}: the name is taken; register it under another")
+        _REGISTERED[name] = factory
+        return factory
+
+    return decorate
+
+
+def _reference() -> None:
+    importlib.import_module("seannet.methods.reference")  # registers the reference methods
+
+
+def _entry_points() -> dict[str, Any]:
+    return {ep.name: ep for ep in entry_points(group=ENTRY_POINT_GROUP)}
+
+
+def method_names() -> list[str]:
+    """Every method a name reaches: the registered ones, the entry points, the model names."""
+    from seannet.model.specs import MODEL_NAMES
+
+    _reference()
+    return [*_REGISTERED, *(n for n in _entry_points() if n not in _REGISTERED), *MODEL_NAMES]
+
+
+def _from_path(target: str) -> Callable[[], Any]:
+    """The factory an import path names: ``package.module:factory`` or ``file.py:factory``."""
+    where, _, attr = target.rpartition(":")
+    if where.endswith(".py"):
+        path = Path(where)
+        if not path.is_file():
+            raise MethodError(f"method {target!r}: no such file {path}")
+        name = f"seannet_user_method_{path.stem}"
+        spec = importlib.util.spec_from_file_location(name, path)
+        assert spec is not None and spec.loader is not None
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[name] = module
+        spec.loader.exec_module(module)
+    else:
+        module = importlib.import_module(where)
+    factory = getattr(module, attr, None)
+    if factory is None:
+        raise MethodError(f"method {target!r}: {where} has no {attr!r}")
+    return factory
+
+
+def load_method(name: str) -> tuple[Callable[[], Any], bool]:
+    """The factory of method ``name`` and whether it is a bundled network (a model spec).
+
+    ``name`` is, in this order: an import path (``pkg.mod:make`` or ``file.py:make``), a name
+    registered with :func:`register_method` (the reference methods included), an entry point
+    of the group ``seannet.methods``, or a model spec (``resnet18+boxes``, ``seannet@lite0``).
+
+    Raises:
+        MethodError: nothing of that name; the message lists what there is.
+    """
+    _reference()
+    try:
+        if ":" in name:
+            return _from_path(name), False
+        if name in _REGISTERED:
+            return _REGISTERED[name], False
+        found = _entry_points()
+        if name in found:
+            return found[name].load(), False
+    except MethodError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - a user's module that fails to import
+        raise MethodError(f"method {name!r}: loading failed: {type(exc).__name__}: {exc}") from None
+    from seannet.model.specs import parse_spec
+
+    try:
+        parse_spec(name)
+    except ModelError:
+        raise MethodError(
+            f"method {name!r}: not registered, no entry point, no import path (pkg.mod:make) and "
+            f"no model spec; registered: {', '.join(_REGISTERED)}"
+        ) from None
+    from seannet.methods.bundled import NetworkMethod
+
+    return (lambda: NetworkMethod(name)), True

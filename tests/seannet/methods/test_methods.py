@@ -1,0 +1,173 @@
+"""seannet.methods: the views a method sees (never the pose), the three ways a method
+registers, and the one-line refusal of a method that breaks a check (no partial card)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+import torch
+
+from seannet.data.batch import SceneBatch
+from seannet.errors import MethodError
+from seannet.methods import BenchmarkConfig, Views, benchmark_method, load_method, register_method
+from seannet.methods.cards import leaderboard, read_cards
+
+FAST = BenchmarkConfig(seeds=(0,), batch_size=16, noise=())
+
+
+def _batch(n: int = 2, m: int = 4) -> SceneBatch:
+    return SceneBatch(
+        images=torch.zeros(n, 3, 8, 8, dtype=torch.uint8),
+        boxes=torch.tensor([[0.0, 0.0, 4.0, 4.0]]),
+        box_view=torch.tensor([1]),
+        class_ids=torch.tensor([0]),
+        slots=torch.tensor([2]),
+        adjacency=torch.zeros(n, 3, m, m),
+        mean=(0.5, 0.5, 0.5),
+        std=(0.5, 0.5, 0.5),
+    )
+
+
+def test_views_show_images_and_objects_never_the_pose() -> None:
+    views = Views(_batch(), method="peek")
+    assert len(views) == 2 and views.images.dtype == torch.uint8
+    assert views.normalised.dtype == torch.float32
+    boxes = views.slot_boxes()
+    assert boxes.shape == (2, 4, 4) and torch.isnan(boxes[0]).all()
+    assert boxes[1, 2].tolist() == [0.0, 0.0, 0.5, 0.5]  # divided by the image side
+    for field in ("pose", "grid_i", "heading", "obs_id", "layout"):
+        with pytest.raises(MethodError, match=r"'peek' read views\." + field):
+            getattr(views, field)
+    with pytest.raises(AttributeError):
+        views.images = None  # type: ignore[misc]
+
+
+class _Constant:
+    def embed(self, views: Views) -> torch.Tensor:
+        return torch.ones(len(views), 3)
+
+
+def test_a_method_registers_three_ways(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    register_method("test-constant")(_Constant)
+    factory, bundled = load_method("test-constant")
+    assert factory is _Constant and not bundled
+    with pytest.raises(MethodError, match="taken"):
+        register_method("test-constant")(lambda: _Constant())
+    with pytest.raises(MethodError, match="taken"):
+        register_method("resnet18")(_Constant)  # a bundled model's name
+    # an import path, a module or a file
+    assert load_method("seannet.methods.reference:TinyImage")[0].__name__ == "TinyImage"
+    user = tmp_path / "mine.py"
+    user.write_text("class Mine:\n    def embed(self, views):\n        return views.images\n")
+    assert load_method(f"{user}:Mine")[0].__name__ == "Mine"
+    # an entry point of an installed distribution (a real dist-info on sys.path)
+    (tmp_path / "plugin_methods.py").write_text("class Plugin:\n    pass\n")
+    info = tmp_path / "plugin_methods-0.1.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: plugin-methods\nVersion: 0.1\n")
+    (info / "entry_points.txt").write_text("[seannet.methods]\nplugged = plugin_methods:Plugin\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    assert load_method("plugged")[0].__name__ == "Plugin"
+    # a model spec is a bundled network
+    assert load_method("resnet18+boxes")[1]
+    with pytest.raises(MethodError, match="no model spec; registered: .*tiny-image"):
+        load_method("nothing-of-that-name")
+
+
+class _NaN(_Constant):
+    def embed(self, views: Views) -> torch.Tensor:
+        out = torch.ones(len(views), 3)
+        out[0, 0] = float("nan")
+        return out
+
+
+class _WrongN(_Constant):
+    def embed(self, views: Views) -> torch.Tensor:
+        return torch.ones(len(views) + 1, 3)
+
+
+class _Ints(_Constant):
+    def embed(self, views: Views) -> torch.Tensor:
+        return torch.ones(len(views), 3, dtype=torch.long)
+
+
+class _OneD(_Constant):
+    def embed(self, views: Views) -> torch.Tensor:
+        return torch.ones(len(views))
+
+
+class _Raises(_Constant):
+    def embed(self, views: Views) -> torch.Tensor:
+        raise KeyError("no such feature")
+
+
+class _Wide(_Constant):
+    def similarity(self, a: torch.Tensor, b: torch.Tensor) -> torch.Tensor:
+        return 2.0 * (a * b).sum(1)  # 6, not a cosine
+
+
+class _Peeks(_Constant):
+    def embed(self, views: Views) -> torch.Tensor:
+        return torch.ones(len(views), 3) * views.heading  # type: ignore[attr-defined]
+
+
+@pytest.mark.parametrize(
+    ("method", "check"),
+    [
+        (_NaN, "check: finite"),
+        (_WrongN, "check: shape"),
+        (_Ints, "check: dtype"),
+        (_OneD, "check: shape"),
+        (_Raises, "embed raised KeyError"),
+        (_Wide, "check: similarity range"),
+        (_Peeks, "check: no pose"),
+    ],
+)
+def test_a_bad_method_is_one_line_and_no_card(
+    tmp_path: Path, mini_dataset: Path, method: type, check: str
+) -> None:
+    name = f"test-bad-{method.__name__.strip('_').lower()}"
+    register_method(name)(method)
+    with pytest.raises(MethodError) as error:
+        benchmark_method(name, mini_dataset, tmp_path, FAST)
+    message = str(error.value)
+    assert name in message and check in message and "\n" not in message
+    assert not list(tmp_path.rglob("card.*"))
+
+
+def test_reference_methods_get_cards_and_a_leaderboard(tmp_path: Path, mini_dataset: Path) -> None:
+    config = BenchmarkConfig(seeds=(0,), batch_size=16)
+    for name in ("tiny-image", "boxes-overlap"):
+        benchmark_method(name, mini_dataset, tmp_path, config)
+    card = json.loads((tmp_path / "boxes-overlap" / "card.json").read_text())
+    summary = card["summary"]
+    assert card["provenance"]["manifest_sha256"] and card["provenance"]["commit"]
+    assert 0.0 <= summary["accuracy"]["mean"] <= 1.0 and summary["triplets"] > 0
+    assert set(summary["change"]) == {"moved_objects", "moved_share", "moved_dynamics"}
+    assert (
+        sum(b["triplets"] for b in summary["change"]["moved_objects"].values())
+        == (summary["triplets"])
+    )
+    assert len(summary["box_noise"]) == len(config.noise)  # boxes: the noise sweep ran
+    assert summary["bytes_per_map_entry"] > 0 and summary["ms_per_view"] > 0
+    tiny = json.loads((tmp_path / "tiny-image" / "card.json").read_text())["summary"]
+    assert "box_noise" not in tiny  # no boxes, no box-noise sweep
+    assert (tmp_path / "tiny-image" / "sweep.png").stat().st_size > 0
+    assert "Benchmark card: tiny-image" in (tmp_path / "tiny-image" / "card.md").read_text()
+    table = leaderboard(read_cards([tmp_path]))
+    assert "`tiny-image`" in table and "`boxes-overlap`" in table
+
+
+def test_a_bundled_network_trains_per_seed(tmp_path: Path, mini_dataset: Path) -> None:
+    config = BenchmarkConfig(seeds=(0, 1), batch_size=16, batches=1, epochs=1, noise=())
+    card = json.loads(
+        benchmark_method("resnet18+boxes", mini_dataset, tmp_path, config).read_text()
+    )
+    assert card["trained"] and card["summary"]["seeds"] == 2
+    assert [r["seed"] for r in card["runs"]] == [0, 1]
+    assert "lambda" in card["runs"][0]["choices"]["box_weight"]  # lambda chosen on val
+    interval = card["summary"]["accuracy_rooms_seeds"]
+    assert interval["low"] <= interval["mean"] <= interval["high"]
+    assert (tmp_path / "runs" / "resnet18" / "lr0.01" / "seed1" / "best.pt").is_file()
