@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pyarrow.parquet as pq
 
+from sgdata.pipeline.config import load_config
 from tests.asset_meshes import write_demo_assets
 
 SGDATA = [sys.executable, "-m", "sgdata_cli.sgdata_app"]
@@ -122,3 +123,9 @@ def test_a_bad_asset_stops_the_run_before_anything_is_written(tmp_path: Path) ->
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and "plate_nan.obj" in lines[0] and "NaN" in lines[0]
     assert not out.exists()
+
+
+def test_the_demo_config_names_the_demo_catalog() -> None:
+    config = load_config(Path(__file__).parents[3] / "configs" / "assets.toml")
+    assert config.catalog.files == ("demo_assets/catalog.toml",)
+    assert config.catalog.paths()[0].parent.name == "demo_assets"
