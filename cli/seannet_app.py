@@ -37,9 +37,13 @@ def train(
     data: Data,
     out: Annotated[Path, typer.Option("--out", help="Run directory for checkpoints.")],
     model: Annotated[
-        str,
-        typer.Option(help=f"One of {', '.join(MODEL_NAMES)}."),
-    ] = "seannet",
+        str | None,
+        typer.Option(
+            help=f"One of {', '.join(MODEL_NAMES)} (default: the preset's: "
+            + ", ".join(f"{v.model.name} in {k}" for k, v in PRESETS.items())
+            + ")."
+        ),
+    ] = None,
     preset: Annotated[str, typer.Option(help=f"One of {', '.join(PRESETS)}.")] = "cpu",
     backbone: Annotated[
         str | None, typer.Option(help=f"SeanNet's image network: {' | '.join(BACKBONES)}.")
@@ -64,7 +68,9 @@ def train(
     from seannet.training.config import preset as load_preset
     from seannet.training.train import train as run_training
 
-    config = load_preset(preset).replace(model=model, seed=seed)
+    config = load_preset(preset).replace(seed=seed)
+    if model:
+        config = config.replace(model=model)
     if backbone:
         config = config.replace(backbone=backbone)
     if epochs:
@@ -161,7 +167,11 @@ def compare(
         typer.Option(help="Candidate learning rates, chosen per model on val (default: preset)."),
     ] = "",
     budget: Annotated[
-        float | None, typer.Option(help="Training seconds per run (same for every model).")
+        float | None,
+        typer.Option(
+            help="Seconds of one thread's compute per run, the same for every model (timed on "
+            "one thread: the machine's load does not change the batches it buys)."
+        ),
     ] = None,
     batches: Annotated[
         int | None, typer.Option(help="Batches per epoch for every model (instead of --budget).")

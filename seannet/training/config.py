@@ -78,39 +78,42 @@ class TrainConfig:
         return dataclasses.asdict(self)
 
 
+# The schedule the cpu and gpu presets share: ResNet-18, x_v from the 5th-stage map, 5 epochs
+# of batches of 16 with the paper's x0.7 decay every 2 epochs.
+_SHORT_SCHEDULE: dict[str, Any] = {
+    "depth": 18,
+    "visual_features": "c5",
+    # with 1 the GCN pathways moved ~10x less than the backbone in the first batches
+    # (bench/branch_motion.py); 10 brings object fcn, GCN and fusion to its order
+    "new_layers_lr_scale": 10.0,
+    "epochs": 5,
+    "batch_size": 16,
+    "decay_every": 2,
+}
+
 PRESETS: dict[str, TrainConfig] = {
     # The paper: ResNet-50 at 224 px, 60 epochs, SGD 0.01 x0.7 every 10 epochs, margin 0.1.
     "paper": TrainConfig(),  # every default: ModelConfig's and the fields above
-    # Two CPU cores in about half an hour for SeanNet: ResNet-18 at 112 px (C4 7 x 7,
-    # RoIAlign 7), 5 epochs of 24 batches of 16 triplets with the paper's x0.7 decay every 2.
-    # Measured here: a SeanNet step takes 9.5 s, a ResNet-18 baseline step 2.0 s. Loader
-    # workers would only compete with torch for the two cores.
+    # Two CPU cores in about half an hour for SeanNet: the short schedule at 112 px (C4 7 x 7,
+    # RoIAlign 7), 24 batches an epoch. Its model is seannet-fc512 (the GCN's fc 512 wide, not
+    # the paper's 4,096): as accurate on val and test, a step 1.19x ResNet-18's instead of
+    # 1.55x (docs/benchmarks.md, docs/results.md). Loader workers would only compete with
+    # torch for the two cores.
     "cpu": TrainConfig().replace(
-        depth=18,
+        model="seannet-fc512",
+        **_SHORT_SCHEDULE,
         image_size=112,
         roi_size=7,
-        visual_features="c5",
-        # with 1 the GCN pathways moved ~10x less than the backbone in the first batches
-        # (bench/branch_motion.py); 10 brings object fcn, GCN and fusion to its order
-        new_layers_lr_scale=10.0,
-        epochs=5,
-        batch_size=16,
-        decay_every=2,
         max_train_batches=24,
         max_val_triplets=160,
         num_workers=0,
     ),
-    # One GPU (run on an H100 with 16 cores, docs/results.md): ResNet-18 at the datasets'
-    # 224 px, x_v from the 5th-stage map, the cpu preset's schedule; loader workers decode the
-    # PNGs in parallel (the runs there were still loader-bound).
+    # One GPU (run on an H100 with 16 cores, docs/results.md): the short schedule at the
+    # datasets' 224 px with the paper's SeanNet; loader workers decode the PNGs in parallel
+    # (the runs there were still loader-bound).
     "gpu": TrainConfig().replace(
-        depth=18,
+        **_SHORT_SCHEDULE,
         roi_size=14,
-        visual_features="c5",
-        new_layers_lr_scale=10.0,
-        epochs=5,
-        batch_size=16,
-        decay_every=2,
         max_val_triplets=320,
         num_workers=12,
     ),
