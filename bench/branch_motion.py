@@ -24,11 +24,11 @@ sys.path.insert(0, str(ROOT))
 
 from seannet.data.datasets import ImageTransform, TripletDataset, collate_triplets  # noqa: E402
 from seannet.model.loss import TripletLoss  # noqa: E402
+from seannet.seeds import init_seed  # noqa: E402
 from seannet.training.config import preset  # noqa: E402
 from seannet.training.loop import train_one_epoch, triplet_step  # noqa: E402
 from seannet.training.runs import build_for_dataset  # noqa: E402
 from seannet.training.train import param_groups  # noqa: E402
-from sgdata.seeds import init_seed  # noqa: E402
 
 PARTS = {
     "backbone (C4)": "backbone.",

@@ -8,13 +8,11 @@ same stream by accident and a path never changes without this file changing::
                   │                                     └─ room_look_seed()  (base looks)
                   ├─ user_room_seed(room id)  (a user's room of [rooms] files; then as above)
                   └─ split_triplets_seed(split) ─ triplet_stream_seed(split, room, tier)
-    training seed ─ init_seed() / epoch_order_seed(epoch) / epoch_dropout_seed(epoch)
-    navigator seed ─ navigator_init_seed() / navigator_pairs_seed(split, room)
-                   ├ navigator_order_seed(epoch)
-                   └ navigator_jitter_seed(epoch)
-    navigation test seed ─ episode_seed(room, case, index)
     layout seed ─ appearance_seed()  (the layout's light and looks of its moving objects)
     texture_seed(kind, variant)  (procedural texture images: no dataset seed, shared by all)
+
+The trainer's seeds (training, navigator, navigation test, box noise) live in
+:mod:`seannet.seeds`, derived with :func:`derive_seed` and :func:`name_key` from here.
 """
 
 from __future__ import annotations
@@ -36,26 +34,12 @@ __all__ = [
     "view_seed",
     "split_triplets_seed",
     "triplet_stream_seed",
-    "init_seed",
-    "epoch_order_seed",
-    "epoch_dropout_seed",
-    "navigator_init_seed",
-    "navigator_pairs_seed",
-    "navigator_order_seed",
-    "navigator_jitter_seed",
-    "episode_seed",
-    "box_noise_seed",
     "room_look_seed",
     "appearance_seed",
     "texture_seed",
 ]
 
 _TRIPLETS = "triplets"  # the purpose key of triplet streams
-_INIT = 1 << 20  # the initial weights (epochs use 0, 1, 2, ...)
-_NAVIGATOR = "navigator"  # the purpose key of the visual navigator's streams
-_JITTER = "jitter"  # the navigator's light jitter, under _NAVIGATOR
-_EPISODES = "episodes"  # the purpose key of the navigation test's episodes
-_BOX_NOISE = "box noise"  # the purpose key of evaluation's labeler / detector noise
 _LOOKS = "looks"  # the purpose key of a room's base looks (texture variants)
 _APPEARANCE = "appearance"  # the purpose key of a layout's appearance draw
 _TEXTURES = "textures"  # the root key of procedural texture images
@@ -121,54 +105,6 @@ def triplet_stream_seed(split_seed: int, split: str, room_id: str, tier: int) ->
     return derive_seed(split_seed, name_key(_TRIPLETS), name_key(split), name_key(room_id), tier)
 
 
-def init_seed(training_seed: int) -> int:
-    """The seed of a model's initial weights."""
-    return derive_seed(training_seed, _INIT)
-
-
-def epoch_order_seed(training_seed: int, epoch: int) -> int:
-    """The seed of an epoch's batch order."""
-    return derive_seed(training_seed, epoch, 0)
-
-
-def epoch_dropout_seed(training_seed: int, epoch: int) -> int:
-    """The seed of an epoch's dropout masks."""
-    return derive_seed(training_seed, epoch, 1)
-
-
-def navigator_init_seed(training_seed: int) -> int:
-    """The seed of the visual navigator's initial weights."""
-    return derive_seed(training_seed, name_key(_NAVIGATOR), _INIT)
-
-
-def navigator_pairs_seed(training_seed: int, split: str, room_id: str) -> int:
-    """The stream of (current, goal) training pairs drawn in one room of one split."""
-    return derive_seed(training_seed, name_key(_NAVIGATOR), name_key(split), name_key(room_id))
-
-
-def navigator_order_seed(training_seed: int, epoch: int) -> int:
-    """The seed of one navigator epoch's batch order."""
-    return derive_seed(training_seed, name_key(_NAVIGATOR), epoch)
-
-
-def navigator_jitter_seed(training_seed: int, epoch: int) -> int:
-    """The seed of one navigator epoch's light jitter (its own stream: turning the jitter on
-    moves no batch order)."""
-    return derive_seed(training_seed, name_key(_NAVIGATOR), name_key(_JITTER), epoch)
-
-
-def episode_seed(test_seed: int, room_id: str, case: str, index: int) -> int:
-    """One navigation-test episode (its layout, start and goal), by names: every localizer
-    run is tested on the same episodes."""
-    return derive_seed(test_seed, name_key(_EPISODES), name_key(room_id), name_key(case), index)
-
-
-def box_noise_seed(noise_seed: int, obs_id: str) -> int:
-    """The noise one view's boxes get in an evaluation under box noise (by name: the same
-    whatever order or batch the view is read in)."""
-    return derive_seed(noise_seed, name_key(_BOX_NOISE), name_key(obs_id))
-
-
 def room_look_seed(room: int) -> int:
     """A room's base looks: the texture variant of its structure and of every object."""
     return derive_seed(room, name_key(_LOOKS))
@@ -187,4 +123,21 @@ def texture_seed(kind: str, variant: int) -> int:
 
 
 # old names, served with a DeprecationWarning for one release
-__getattr__ = moved_names(__name__, {"own_room_seed": "sgdata.seeds:user_room_seed"})
+_SEANNET = (
+    "init_seed",
+    "epoch_order_seed",
+    "epoch_dropout_seed",
+    "navigator_init_seed",
+    "navigator_pairs_seed",
+    "navigator_order_seed",
+    "navigator_jitter_seed",
+    "episode_seed",
+    "box_noise_seed",
+)
+__getattr__ = moved_names(
+    __name__,
+    {
+        "own_room_seed": "sgdata.seeds:user_room_seed",
+        **{name: f"seannet.seeds:{name}" for name in _SEANNET},  # the trainer's own seeds
+    },
+)

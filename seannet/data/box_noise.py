@@ -2,7 +2,7 @@
 
 Evaluation under :class:`BoxNoise` asks how much of a model's accuracy survives boxes that
 are not the generator's exact ones (DESIGN §12). Each view's noise is drawn from its own
-seeded stream (:func:`sgdata.seeds.box_noise_seed` of the noise seed and the view's id), so a
+seeded stream (:func:`seannet.seeds.box_noise_seed` of the noise seed and the view's id), so a
 view is perturbed the same way whatever batch or order it is read in, and every model
 evaluated under one noise sees the same perturbed boxes.
 
@@ -21,7 +21,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from seannet.errors import DataError
-from sgdata.seeds import box_noise_seed, rng_for
+from seannet.seeds import box_noise_seed
+from sgdata.seeds import rng_for
 
 __all__ = ["BoxNoise", "ObjectColumns"]
 

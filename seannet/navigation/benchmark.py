@@ -1,7 +1,7 @@
 """``seannet navigate``: the navigation benchmark (paper Table II) of localizer runs.
 
 Every localizer run is tested on the same episodes: each is drawn from
-:func:`sgdata.seeds.episode_seed` (test seed, room, case, index) and from the map's structure,
+:func:`seannet.seeds.episode_seed` (test seed, room, case, index) and from the map's structure,
 which is the same whatever run embedded it. Maps are built once per run and room into
 ``<maps>/<run label>/<room>/`` and reused (:func:`seannet.navigation.maps.ensure_map`).
 
@@ -51,10 +51,11 @@ from seannet.navigation.maps import (
 from seannet.navigation.navigator import load_navigator, resize
 from seannet.navigation.tables import markdown, write_results
 from seannet.provenance import append_provenance
+from seannet.seeds import episode_seed
 from seannet.training.runs import BEST, check_same_dataset, load_checkpoint
 from sgdata.fileio import atomic_write_text, save_png
 from sgdata.pipeline.executors import run_tasks
-from sgdata.seeds import episode_seed, rng_for
+from sgdata.seeds import rng_for
 
 __all__ = [
     "ORACLE",

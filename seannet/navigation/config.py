@@ -99,7 +99,7 @@ class NavigationTestConfig:
 
     split: str = "test"  # the rooms episodes run in
     episodes: int = 20  # per case (N, A) and room
-    seed: int = 0  # of the episodes (sgdata.seeds.episode_seed)
+    seed: int = 0  # of the episodes (seannet.seeds.episode_seed)
     k_max: int = K_MAX  # steps per segment
     spacing: int = MAP_SPACING  # cells between map nodes
     replan: bool = False  # also run bump and replan (its paper-rule outcome read off the same run)

@@ -3,12 +3,12 @@
 Train pairs come from every layout of the train rooms, val pairs from the val rooms
 (:func:`seannet.navigation.pairs.render_pairs`, rendered once into a cache and reused by every
 epoch and by later runs with the same key). The batch order of each epoch comes from
-:func:`sgdata.seeds.navigator_order_seed`; the training goes through
+:func:`seannet.seeds.navigator_order_seed`; the training goes through
 :func:`seannet.training.loop.train_one_epoch` and the val accuracy through
 :func:`seannet.training.loop.collect`. ``best.pt`` is the epoch of the best val accuracy, which
 is also reported per action and per goal distance. Cross-entropy, SGD. What the test changes
 can be trained for: goal views of another layout (``cross_layout``, in the pairs) and light
-jitter per view (``jitter``, per epoch from :func:`sgdata.seeds.navigator_jitter_seed`).
+jitter per view (``jitter``, per epoch from :func:`seannet.seeds.navigator_jitter_seed`).
 """
 
 from __future__ import annotations
@@ -31,15 +31,11 @@ from seannet.navigation.motion import NAVIGATOR_ACTIONS
 from seannet.navigation.navigator import KIND, NavigatorConfig, VisualNavigator, navigator_inputs
 from seannet.navigation.pairs import PairSet, render_pairs
 from seannet.provenance import append_provenance
+from seannet.seeds import navigator_init_seed, navigator_jitter_seed, navigator_order_seed
 from seannet.training.loop import Progress, collect, train_one_epoch
 from seannet.training.runs import BEST, HISTORY, LAST, device_for_run, save_checkpoint
 from sgdata.fileio import atomic_write_text
-from sgdata.seeds import (
-    navigator_init_seed,
-    navigator_jitter_seed,
-    navigator_order_seed,
-    rng_for,
-)
+from sgdata.seeds import rng_for
 
 __all__ = ["fit_navigator", "jitter", "pair_accuracy", "train_navigator"]
 

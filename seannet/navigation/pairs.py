@@ -1,6 +1,6 @@
 """The navigator's (current, goal) pairs: drawn per room, rendered once, cached on disk.
 
-Pairs are drawn per room from seeded streams (:func:`sgdata.seeds.navigator_pairs_seed`) over
+Pairs are drawn per room from seeded streams (:func:`seannet.seeds.navigator_pairs_seed`) over
 every layout of the room (:func:`seannet.navigation.navigator.draw_pair`) and rendered live
 (:class:`seannet.data.live_views.LiveRooms`) at the dataset's camera, then resized to the
 navigator's input as the localizers' images are. A cache directory holds one ``.npz`` per room
@@ -26,8 +26,9 @@ from seannet.data.live_views import LiveRooms
 from seannet.errors import DataError
 from seannet.navigation.motion import local_offset
 from seannet.navigation.navigator import NavigatorConfig, draw_pair, resize
+from seannet.seeds import navigator_pairs_seed
 from sgdata.fileio import atomic_write_bytes, atomic_write_text
-from sgdata.seeds import navigator_pairs_seed, rng_for
+from sgdata.seeds import rng_for
 
 __all__ = ["PairSet", "pairs_key", "render_pairs"]
 

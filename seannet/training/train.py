@@ -27,6 +27,7 @@ from seannet.errors import CheckpointError
 from seannet.model.loss import TripletLoss
 from seannet.model.pretrained import check_pretrained_request
 from seannet.provenance import append_provenance
+from seannet.seeds import epoch_dropout_seed, epoch_order_seed, init_seed
 from seannet.training.config import TrainConfig
 from seannet.training.loop import Progress, collect, train_one_epoch, triplet_correct, triplet_step
 from seannet.training.runs import (
@@ -40,7 +41,6 @@ from seannet.training.runs import (
     save_checkpoint,
 )
 from sgdata.fileio import atomic_write_text
-from sgdata.seeds import epoch_dropout_seed, epoch_order_seed, init_seed
 
 __all__ = ["EpochResult", "evaluate_triplets", "param_groups", "train", "train_loader"]
 

@@ -17,6 +17,8 @@ MOVED = [
     ("sgdata.dataset.rows", "sha256_file", "sgdata.fileio", "sha256_file"),
     ("sgdata.usd.stage", "write_text_atomic", "sgdata.usd.stage", "write_usd_file"),
     ("sgdata.dataset.manifest", "write_manifest", "sgdata.dataset.publish", "write_manifest"),
+    ("sgdata.seeds", "init_seed", "seannet.seeds", "init_seed"),
+    ("sgdata.seeds", "episode_seed", "seannet.seeds", "episode_seed"),
 ]
 
 

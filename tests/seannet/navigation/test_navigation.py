@@ -38,7 +38,8 @@ from seannet.navigation.navigator import (
     load_navigator,
 )
 from seannet.navigation.tables import case_rates, read_results
-from sgdata.seeds import episode_seed, rng_for
+from seannet.seeds import episode_seed
+from sgdata.seeds import rng_for
 
 EPS = 0.9
 GOAL = (4, 2, 0)

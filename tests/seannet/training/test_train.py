@@ -16,10 +16,10 @@ from seannet.data.datasets import ImageTransform, TripletDataset, collate_triple
 from seannet.errors import CheckpointError
 from seannet.evaluation.run_eval import evaluate_run
 from seannet.model.loss import TripletLoss
+from seannet.seeds import init_seed
 from seannet.training.config import TrainConfig
 from seannet.training.runs import build_for_dataset, load_checkpoint
 from seannet.training.train import train
-from sgdata.seeds import init_seed
 
 # Small enough for a CPU test: ResNet-18 at 64 px, 12 triplets an epoch, no loader workers.
 FAST = TrainConfig().replace(
