@@ -423,9 +423,9 @@ def benchmark(
     methods: Annotated[
         str,
         typer.Option(
-            help="Comma-separated methods: a registered name (tiny-image, lite0-gem, "
-            "boxes-overlap, boxes-kernel, an entry point of seannet.methods), an import path "
-            "pkg.module:factory or path/file.py:factory, or a model spec (resnet18+boxes)."
+            help="Comma-separated methods: a registered name or entry point (`seannet "
+            "methods` lists them), an import path pkg.module:factory or path/file.py:factory, "
+            "or a model spec (resnet18+boxes)."
         ),
     ],
     out: Annotated[Path, typer.Option("--out", help="Directory for the cards (one per method).")],
@@ -459,6 +459,14 @@ def benchmark(
         card = benchmark_method(name, data, out, config, announce=console.print)
         typer.echo(card.with_name("card.md").read_text())
         console.print(f"wrote {card} and its .md, sweep.png")
+
+
+@app.command(name="methods")
+def list_methods() -> None:
+    """Every method name `seannet benchmark` accepts: registered, entry points, model names."""
+    from seannet.methods.registry import method_names
+
+    typer.echo("\n".join(method_names()))
 
 
 @app.command()
