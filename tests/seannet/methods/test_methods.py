@@ -171,3 +171,23 @@ def test_a_bundled_network_trains_per_seed(tmp_path: Path, mini_dataset: Path) -
     interval = card["summary"]["accuracy_rooms_seeds"]
     assert interval["low"] <= interval["mean"] <= interval["high"]
     assert (tmp_path / "runs" / "resnet18" / "lr0.01" / "seed1" / "best.pt").is_file()
+
+
+def test_the_change_of_a_pair_agrees_with_moved_objects(mini_dataset: Path) -> None:
+    from seannet.data.datasets import open_dataset
+    from seannet.data.moved import moved_objects
+    from seannet.methods.change import DYNAMICS_BINS, change_of_pairs, share_bin
+
+    dataset = open_dataset(mini_dataset)
+    table = dataset.triplets("test")
+    columns = (table.column(c).to_pylist() for c in ("anchor", "positive", "negative"))
+    obs = list(zip(*columns, strict=True))
+    change = change_of_pairs(dataset, "test", [(a, p) for a, p, _ in obs])
+    assert change.moved.tolist() == moved_objects(mini_dataset, "test", obs).tolist()
+    assert ((change.share > 0) == (change.moved > 0)).all()
+    assert ((change.share >= 0) & (change.share <= 1)).all()
+    assert set(change.dynamics) <= set(DYNAMICS_BINS)
+    assert [d == "none" for d in change.dynamics] == [m == 0 for m in change.moved]
+    assert (share_bin(0.0), share_bin(0.05), share_bin(0.3), share_bin(0.9)) == (
+        "0", "<=10%", "25-50%", ">50%"
+    )  # fmt: skip
