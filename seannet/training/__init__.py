@@ -1,9 +1,13 @@
 """Stage 3, training: ``TrainConfig`` and its presets, the one training loop and the one
-evaluation loop, run directories (checkpoints, restoring a run), and ``train``."""
+evaluation loop, run directories (checkpoints, restoring a run), ``train``, and the budget
+(batches a budget of one thread's seconds buys, load-robust)."""
 
 from sgdata.lazy_face import lazy_face
 
 _EXPORTS = {
+    "Calibration": ".budget",
+    "calibrate": ".budget",
+    "calibrate_batches": ".budget",
     "PRESETS": ".config",
     "TrainConfig": ".config",
     "preset": ".config",
