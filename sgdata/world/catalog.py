@@ -161,8 +161,9 @@ def load_catalog(path: str | Path | None = None, *, extra: Sequence[str | Path] 
     """Load and validate a catalog TOML file (the shipped one by default), merged with the
     user's catalog files ``extra`` in order: a class of theirs is new (appended to the
     vocabulary) or overrides the fields it names of a class before it (in place). A user's
-    class may name mesh files instead of a recipe (``mesh``, :mod:`sgdata.world.mesh_assets`),
-    relative to its own file's folder; those files are read and measured here.
+    class may name mesh files instead of a recipe (``mesh``, relative to its own file's folder):
+    the files are found here, and read, checked and measured on first use
+    (:func:`sgdata.world.mesh_assets.class_assets`).
 
     Raises:
         CatalogError: naming the file, the class and the field at fault (or the mesh file).
@@ -372,11 +373,7 @@ def _check_references(path: Path, specs: dict[str, ClassSpec]) -> None:
     )
 
     for spec in specs.values():
-        if spec.mesh is not None:
-            from sgdata.world.mesh_assets import class_assets  # late: reads the mesh files
-
-            class_assets(spec)  # every file read, checked and measured once, here
-        elif spec.shape not in RECIPES:
+        if spec.mesh is None and spec.shape not in RECIPES:
             raise CatalogError(
                 f"{path}: class {spec.name}: field 'shape' is {spec.shape!r}; "
                 f"no such recipe in sgdata.world.shapes"

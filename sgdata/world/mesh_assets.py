@@ -26,12 +26,15 @@ import re
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from sgdata.errors import CatalogError
-from sgdata.world.catalog import Catalog, ClassSpec, MeshSource
 from sgdata.world.shapes.base import Part, ShapeBuild, Surface
+
+if TYPE_CHECKING:
+    from sgdata.world.catalog import Catalog, ClassSpec, MeshSource
 
 __all__ = [
     "MESH_FORMATS",

@@ -145,7 +145,7 @@ def _refusal(tmp_path: Path, name: str, data: bytes | str, entry: str = "") -> s
     path.write_bytes(data if isinstance(data, bytes) else data.encode())
     user = _catalog_with(tmp_path, f'mesh = "{name}"\n{entry}', "Plate")
     with pytest.raises(CatalogError) as info:
-        load_catalog(extra=[user])
+        class_assets(load_catalog(extra=[user])["Plate"])
     message = str(info.value)
     assert "\n" not in message
     return message
