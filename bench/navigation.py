@@ -59,6 +59,7 @@ from seannet.navigation.stop_threshold import (  # noqa: E402
     choose_epsilon,
 )
 from seannet.navigation.tables import (  # noqa: E402
+    INTERVAL,
     RATE_HEADER,
     SPLIT_HEADER,
     TIME_HEADER,
@@ -285,7 +286,7 @@ def measured_block(out: Path, suffix: str = "") -> str:
     lines += [
         "",
         f"{episodes} episodes per case and room, the same for every localizer (seed "
-        f"{results['seed']}); each cell: percent [Wilson 95 % interval], N / A.",
+        f"{results['seed']}); each cell: percent [{INTERVAL}], N / A.",
         "",
         "The paper's rule (a collision ends the episode), beside the paper's Table II:",
         "",

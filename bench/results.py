@@ -3,8 +3,9 @@
     python bench/results.py run DATA RUNS [--steps headline,noise,ablations] [--budget 150]
     python bench/results.py tables DATA RUNS [-o docs/results.md]
 
-``run`` records what made the runs (commit, command, dataset manifest sha256 and format
-version) in ``RUNS/provenance-<step>.json`` and runs each step:
+``run`` appends what made the runs (commit at process start, command, dataset manifest sha256
+and format version) to ``RUNS/provenance.jsonl`` (:mod:`seannet.provenance`), one record per
+step and call, and runs each step:
 
 - ``headline``: ``seannet compare`` of SeanNet, ``resnet18+boxes`` and ResNet-18, 3 seeds,
   lr from {0.003, 0.01} on val, 150 s per run (the protocol: selection.json before test);
@@ -32,9 +33,7 @@ from __future__ import annotations
 
 import argparse
 import json
-import subprocess
 import sys
-import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -45,11 +44,14 @@ sys.path.insert(0, str(ROOT))
 from seannet.data.box_noise import BoxNoise  # noqa: E402
 from seannet.data.datasets import open_dataset  # noqa: E402
 from seannet.evaluation.compare import compare_models  # noqa: E402
-from seannet.evaluation.eval import eval_file, evaluate_run, scene_term  # noqa: E402
+from seannet.evaluation.compare import markdown as comparison_markdown  # noqa: E402
+from seannet.evaluation.run_eval import eval_file, evaluate_run  # noqa: E402
+from seannet.model.specs import scene_term  # noqa: E402
 from seannet.navigation.localizer import load_localizer  # noqa: E402
 from seannet.navigation.map_localization import run_localize  # noqa: E402
 from seannet.navigation.maps import build_maps  # noqa: E402
-from sgdata.fileio import atomic_write_text, sha256_file  # noqa: E402
+from seannet.provenance import append_provenance, read_provenance, stamp  # noqa: E402
+from sgdata.fileio import atomic_write_text  # noqa: E402
 
 SEEDS = (0, 1, 2)
 LRS = (0.003, 0.01)
@@ -79,37 +81,11 @@ FULL_MAP_MODELS = ("seannet", "resnet18")
 FULL_MAP = "localize_test.json"  # what `seannet localize --split test` writes per run
 
 
-def provenance(data: Path, command: list[str]) -> dict[str, Any]:
-    """What made a set of runs: the code's commit, the command, the data's fingerprint."""
-    commit = subprocess.run(
-        ["git", "rev-parse", "HEAD"], capture_output=True, text=True, cwd=ROOT, check=False
-    ).stdout.strip()
-    dirty = subprocess.run(
-        ["git", "status", "--porcelain", "--untracked-files=no"],
-        capture_output=True,
-        text=True,
-        cwd=ROOT,
-        check=False,
-    ).stdout.strip()
-    manifest = json.loads((data / "dataset.json").read_text())
-    return {
-        "commit": commit,
-        "dirty": bool(dirty),
-        "command": " ".join(command),
-        "started": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
-        "data": str(data),
-        "manifest_sha256": sha256_file(data / "dataset.json")[0],
-        "format_version": manifest["format_version"],
-        "dataset_seed": manifest["config"]["dataset"]["seed"],
-    }
-
-
 def run(args: argparse.Namespace) -> None:
     runs: Path = args.runs
     runs.mkdir(parents=True, exist_ok=True)
     for step in args.steps.split(","):
-        record = provenance(args.data, sys.argv)
-        atomic_write_text(runs / f"provenance-{step}.json", json.dumps(record, indent=2))
+        append_provenance(runs, args.data, step=step)
         if step in COMPARISONS:
             compare_models(
                 args.data,
@@ -200,14 +176,10 @@ def _budget(seconds: float | None) -> str:
     return f"{seconds:g} s of training per run (batches per epoch from each network's timed steps)"
 
 
-def _stamp(record: dict[str, Any]) -> str:
-    dirty = " (with uncommitted changes)" if record["dirty"] else ""
-    return (
-        f"*Runs of commit `{record['commit'][:10]}`{dirty}, started {record['started']}; data "
-        f"`{record['data']}` (dataset seed {record['dataset_seed']}, format "
-        f"{record['format_version']}, manifest sha256 `{record['manifest_sha256'][:16]}…`); "
-        f"made by `python {record['command']}`.*"
-    )
+def _stamp(runs: Path, step: str) -> list[str]:
+    """The stamp naming every call of ``step`` that wrote into ``runs``, and a blank line."""
+    records = read_provenance(runs, step)
+    return [stamp(records), ""] if records else []
 
 
 def _comparison_tables(result: dict[str, Any]) -> list[str]:
@@ -217,32 +189,9 @@ def _comparison_tables(result: dict[str, Any]) -> list[str]:
         f"the whole val split from {result['lrs']} with seed {result['seeds'][0]}, then seeds "
         f"{result['seeds']} at it; test read once, after `selection.json` was written.",
         "",
-        "| model | lr | val acc | test acc, mean ± 95 % (seeds t) | rooms × seeds 95 % "
-        "| seeds | batches / epoch | recall@1 (dataset views) | d' |",
-        "|---|---|---|---|---|---|---|---|---|",
+        # seannet compare's own tables (comparison-<step>.md), without their title
+        *comparison_markdown(result).rstrip("\n").splitlines()[2:],
     ]
-    for e in result["models"]:
-        s = e["summary"]
-        val = e["val_accuracy_by_lr"][f"{e['lr']:g}"]
-        lines.append(
-            f"| {e['model']} | {e['lr']:g} | {_pct(val)} | {_pm(s['accuracy'])} | "
-            f"[{_pct(s['two_level']['low'])}, {_pct(s['two_level']['high'])}] | "
-            f"{s['accuracy']['n']} | {e['batches_per_epoch']} | {_pm(s['recall1'])} | "
-            f"{s['d_prime']['mean']:.2f} |"
-        )
-    first = result["models"][0]["model"]
-    lines += [
-        "",
-        f"{first} minus each model on the same {result['models'][0]['summary']['rooms']} "
-        "rooms, points (95 %): the paired two-level bootstrap (rooms × seeds) and Welch's "
-        "interval over seeds:",
-        "",
-        "| model | rooms × seeds | seeds (Welch t) |",
-        "|---|---|---|",
-    ]
-    for e in result["models"][1:]:
-        d = e["difference_to_first"]
-        lines.append(f"| {e['model']} | {_span(d, True)} | {_span(d['seeds_t'], True)} |")
     tiers = sorted(result["models"][0]["summary"]["per_tier"], key=int)
     lines += [
         "",
@@ -255,27 +204,11 @@ def _comparison_tables(result: dict[str, Any]) -> list[str]:
     for e in result["models"]:
         per = e["summary"]["per_tier"]
         lines.append(f"| {e['model']} | " + " | ".join(_pct(per[k]["mean"]) for k in tiers) + " |")
-    bins = list(result["models"][0]["summary"]["by_moved"])
-    lines += [
-        "",
-        "By moved objects in view between anchor and positive (mean over seeds, %):",
-        "",
-        "| model | " + " | ".join(bins) + " |",
-        "|---|" + "---|" * len(bins),
-    ]
-    for e in result["models"]:
-        moved = e["summary"]["by_moved"]
-        lines.append(f"| {e['model']} | " + " | ".join(_pct(moved[b]["mean"]) for b in bins) + " |")
     boxes = [e for e in result["models"] if scene_term(e["model"])]
     for e in boxes:
         weights = [r["box_weight"]["lambda"] for r in e["runs"]]
         lines += ["", f"{e['model']}: lambda chosen on val per seed: {weights}."]
     return lines
-
-
-def _noise_stamp(runs: Path) -> list[str]:
-    path = runs / "provenance-noise.json"
-    return [_stamp(json.loads(path.read_text())), ""] if path.exists() else []
 
 
 def _noise_table(runs: Path, result: dict[str, Any]) -> list[str]:
@@ -352,7 +285,8 @@ def _reading(runs: Path, result: dict[str, Any]) -> list[str]:
     stds = ", ".join(
         f"{name} {100 * e['summary']['accuracy']['std']:.1f}" for name, e in by.items()
     )
-    lines.append(f"- Seed-to-seed spread (std over 3 seeds, points): {stds}.")
+    seeds = by["seannet"]["summary"]["accuracy"]["n"]
+    lines.append(f"- Seed-to-seed spread (std over {seeds} seeds, points): {stds}.")
     for name in NOISE_MODELS:
         if name in by and _aim_losses(runs, result, name):
             lines.append(f"- {name} at S = 0.05, P = 0.1 loses {_noise_loss(runs, result, name)}.")
@@ -394,7 +328,6 @@ def _full_map_section(runs: Path) -> list[str]:
     found = _full_map_results(runs)
     if not found:
         return []
-    record = runs / "provenance-fullmap.json"
     bins = list(next(iter(found.values()))[0]["by_moved"])
     lines = [
         "",
@@ -406,7 +339,7 @@ def _full_map_section(runs: Path) -> list[str]:
         "Queries whose pose is blocked in layout 0 have no true sub-node and are left out. "
         "One seed per model (a map is rendered per run): no interval over seeds.",
         "",
-        *([_stamp(json.loads(record.read_text())), ""] if record.exists() else []),
+        *_stamp(runs, "fullmap"),
         "| model | queries | recall@1 | recall@5 | "
         + " | ".join(f"recall@1, {b} moved" for b in bins)
         + " |",
@@ -443,7 +376,6 @@ def _comparison_section(
     path = runs / f"comparison-{step}.json"
     if not path.exists():
         return []
-    record = json.loads((runs / f"provenance-{step}.json").read_text())
     result = json.loads(path.read_text())
     said = [*reading(result), ""] if reading else []
     return [
@@ -452,8 +384,7 @@ def _comparison_section(
         "",
         intro,
         "",
-        _stamp(record),
-        "",
+        *_stamp(runs, step),
         *said,
         *_comparison_tables(result),
     ]
@@ -487,31 +418,36 @@ def _kernel_reading(result: dict[str, Any]) -> list[str]:
     return lines
 
 
+def _val_accuracy(entry: dict[str, Any]) -> float:
+    """A model's val accuracy at its chosen learning rate (what it is chosen by)."""
+    return entry["val_accuracy_by_lr"][f"{entry['lr']:g}"]
+
+
 def tables(runs: Path) -> str:
     """docs/results.md from the run files under ``runs``."""
     head = json.loads((runs / "comparison-headline.json").read_text())
-    record = json.loads((runs / "provenance-headline.json").read_text())
     models = {e["model"]: e for e in head["models"]}
     ours = models["seannet"]["summary"]
     baselines = [e for e in head["models"] if e["model"] != "seannet"]
-    strongest = max(baselines, key=lambda e: e["summary"]["accuracy"]["mean"])
+    strongest = max(baselines, key=_val_accuracy)  # chosen on val, as every choice
     gap = strongest["difference_to_first"]
     out = [
         "# Results: SeanNet against the strongest simple baselines",
         "",
         "Written by `python bench/results.py tables DATA RUNS` from the run files; no figure "
         "here is typed by hand. The protocol (DESIGN §12, `seannet compare`): every choice on "
-        "the validation rooms, the test rooms read once per chosen configuration, 3 seeds per "
+        "the validation rooms, the test rooms read once per chosen configuration, "
+        f"{len(head['seeds'])} seeds per "
         "row, intervals over rooms and seeds. The data is `medium` of today's generator "
         "(textures, per-layout light and looks, lived-in layouts) drawn with a dataset seed "
-        "no earlier figure or design choice used (`configs/results.toml`): its 20 test rooms "
-        "never informed the model.",
+        "no earlier figure or design choice used (`configs/results.toml`): its "
+        f"{ours['rooms']} test rooms never informed the model.",
         "",
-        _stamp(record),
-        "",
+        *_stamp(runs, "headline"),
         "## Headline",
         "",
-        f"- SeanNet: **{_pm(ours['accuracy'])} %** triplet accuracy on 20 unseen rooms "
+        f"- SeanNet: **{_pm(ours['accuracy'])} %** triplet accuracy on {ours['rooms']} unseen "
+        "rooms "
         f"(rooms × seeds 95 %: [{_pct(ours['two_level']['low'])}, "
         f"{_pct(ours['two_level']['high'])}]).",
         f"- The strongest baseline, {strongest['model']}: "
@@ -545,7 +481,7 @@ def tables(runs: Path) -> str:
         "",
         "## Under labeler / detector box noise",
         "",
-        *_noise_stamp(runs),
+        *_stamp(runs, "noise"),
         *_noise_table(runs, head),
     ]
     out += _comparison_section(

@@ -136,17 +136,7 @@ def run_navigation(
     labels = dict(zip(runs, run_labels(runs), strict=True))
     _build_maps(localizers, data, rooms, {r: maps / labels[r] for r in runs}, config, workers, say)
     jobs = {
-        (loc.run, room_id, case): {
-            **settings,
-            "run": str(loc.run),
-            "checkpoint_sha256": loc.digest,
-            "epsilon": loc.epsilon,
-            "room_id": room_id,
-            "case": case,
-            "label": labels[loc.run],
-            "map": str(maps / labels[loc.run] / room_id),
-            "strips": str(strips / labels[loc.run]) if strips is not None else None,
-        }
+        (loc.run, room_id, case): _job(settings, loc, labels[loc.run], room_id, case, maps, strips)
         for loc in localizers
         for room_id in rooms
         for case in CASES
@@ -160,17 +150,7 @@ def run_navigation(
             episode for room_id in rooms for case in CASES
             for episode in _finished_part(jobs[loc.run, room_id, case], out)
         ]  # fmt: skip
-        results["runs"].append(
-            {
-                "run": str(loc.run),
-                "label": labels[loc.run],
-                "model": loc.name,
-                "epsilon": loc.epsilon,
-                "epsilon_source": loc.epsilon_source,
-                "checkpoint_sha256": loc.digest,
-                "episodes": records,
-            }
-        )
+        results["runs"].append(_run_entry(loc, labels[loc.run], records))
     out.mkdir(parents=True, exist_ok=True)
     append_provenance(out, data, step=results_path(out, config.split).stem)
     write_results(results, results_path(out, config.split))
@@ -220,6 +200,42 @@ def _build_maps(
     ]
     for done in run_tasks(_map_task, jobs, workers=workers):
         say(f"map of {done['room_id']} by {done['run']}")
+
+
+def _job(
+    settings: dict[str, Any],
+    loc: Localizer,
+    label: str,
+    room_id: str,
+    case: str,
+    maps: Path,
+    strips: Path | None,
+) -> dict[str, Any]:
+    """One task: the episodes of one (run, room, case); its key fields say what they depend on."""
+    return {
+        **settings,
+        "run": str(loc.run),
+        "checkpoint_sha256": loc.digest,
+        "epsilon": loc.epsilon,
+        "room_id": room_id,
+        "case": case,
+        "label": label,
+        "map": str(maps / label / room_id),
+        "strips": str(strips / label) if strips is not None else None,
+    }
+
+
+def _run_entry(loc: Localizer, label: str, records: list[dict[str, Any]]) -> dict[str, Any]:
+    """A run's entry of the results: what it is, its threshold, its episodes."""
+    return {
+        "run": str(loc.run),
+        "label": label,
+        "model": loc.name,
+        "epsilon": loc.epsilon,
+        "epsilon_source": loc.epsilon_source,
+        "checkpoint_sha256": loc.digest,
+        "episodes": records,
+    }
 
 
 def _finished_part(job: dict[str, Any], out: Path) -> list[dict[str, Any]]:

@@ -19,6 +19,7 @@ import torch
 
 from seannet.data.datasets import ImageTransform, ViewTensors, collate_views
 from seannet.errors import NavigationError
+from seannet.evaluation.run_eval import eval_file
 from seannet.model.pretrained import file_sha256
 from seannet.training.config import TrainConfig
 from seannet.training.loop import collect, embed_batch
@@ -68,7 +69,7 @@ def run_epsilon(run: Path) -> tuple[float, str] | None:
     ``eval_val.json``, then ``eval_test.json``, then any other ``eval_*.json``; files whose
     epsilon is missing or NaN are skipped. None when no file has one.
     """
-    names = [f"eval_{s}.json" for s in EVAL_SPLITS]
+    names = [eval_file(run, s).name for s in EVAL_SPLITS]
     others = sorted(p.name for p in run.glob("eval_*.json") if p.name not in names)
     for name in [*names, *others]:
         path = run / name

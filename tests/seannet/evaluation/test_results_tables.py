@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 
 from seannet.evaluation.compare import compare_models
+from seannet.provenance import append_provenance
 from seannet.training.config import TrainConfig
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -33,13 +34,27 @@ def test_tables_are_the_runs_figures(
         lrs=(0.01,),  # one lr: the selection is compare's own test
         tag="headline",
     )
-    record = results.provenance(mini_dataset, ["bench/results.py", "run", "tiny"])
-    (runs / "provenance-headline.json").write_text(json.dumps(record))
+    record = append_provenance(runs, mini_dataset, step="headline")
     results.noise_step(mini_dataset, runs, grid=(results.AIM,))  # the aim's point only
     doc = results.tables(runs)
     # the stamp names the code and the data the runs were made with
     assert f"`{record['commit'][:10]}`" in doc
-    assert record["manifest_sha256"][:16] in doc and "bench/results.py run tiny" in doc
+    assert record["manifest_sha256"][:16] in doc and record["command"] in doc
+    # counts come from the runs: the mini dataset has one test room, two seeds per row
+    rooms = head["models"][0]["summary"]["rooms"]
+    assert rooms == 1 and f"triplet accuracy on {rooms} unseen rooms" in doc
+    assert "2 seeds per row" in doc and "std over 2 seeds" in doc
+    # the strongest baseline is the one with the best val accuracy, whatever test says: give
+    # the baseline weaker on test the better val accuracy, and it is the one named
+    path = runs / "comparison-headline.json"
+    kept = path.read_text()
+    tampered = json.loads(kept)
+    weaker = min(tampered["models"][1:], key=lambda e: e["summary"]["accuracy"]["mean"])
+    for e in tampered["models"][1:]:
+        e["val_accuracy_by_lr"][f"{e['lr']:g}"] = 0.9 if e is weaker else 0.1
+    path.write_text(json.dumps(tampered))
+    assert f"- The strongest baseline, {weaker['model']}: " in results.tables(runs)
+    path.write_text(kept)
     # every model's row carries its own figures
     for entry in head["models"]:
         s = entry["summary"]
@@ -67,7 +82,7 @@ def test_tables_are_the_runs_figures(
         "seannet",
         "resnet18",
     }
-    (runs / "provenance-kernel.json").write_text(json.dumps(record))
+    append_provenance(runs, mini_dataset, step="kernel")
     doc = results.tables(runs)
     assert "## A learned scene term" in doc
     ours = kernel["models"][0]["summary"]["accuracy"]["mean"]

@@ -56,6 +56,12 @@ def test_tables_from_tiny_runs(
     (run,) = results["runs"]
     label = f"| {run['model']} ({run['label']}) | 2 / 2 |"
     assert text.count(label) == 2  # the paper rule's table and --replan's
+    # the rates are the episodes': success per case under the paper's rule, counted here
+    (row,) = [line for line in text.splitlines() if line.startswith(label)][:1]
+    for case in ("N", "A"):
+        mine = [e for e in run["episodes"] if e["case"] == case]
+        won = sum(e["paper"]["outcome"] == "success" for e in mine)
+        assert f"{100 * won / len(mine):.1f} [" in row.split("|")[3].split("/")[case == "A"]
     assert "Bump and replan" in text and "path blocked % N / A" in text
     assert "Time per episode" in text and "Val accuracy by action" in text
     bench.write_tables(out, doc)
