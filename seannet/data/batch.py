@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
 import torch
@@ -60,6 +60,7 @@ class SceneBatch:
         ``slots``             (K,)                   long, both
         ``adjacency``         (B, 3, M, M)           sparse COO float32 / dense float32
         ``mean``, ``std``     3 floats each          the transform's / None
+        ``channels[name]``    (B, H, W)              as the loader gives them, both
         ====================  =====================  ===========================================
 
     Attributes:
@@ -79,6 +80,9 @@ class SceneBatch:
             ``images`` with (the :class:`~seannet.data.view_inputs.ImageTransform`'s);
             None for float.
         std: per-channel std, as ``mean``.
+        channels: the per-view channels asked of the dataset, name -> (B, H, W) tensor in
+            the images' frame (``depth`` float32 metres, ``instances`` / ``classes`` int64:
+            :mod:`seannet.data.view_channels`); empty unless asked for. The models ignore them.
     """
 
     images: Tensor
@@ -89,6 +93,7 @@ class SceneBatch:
     adjacency: Tensor
     mean: tuple[float, float, float] | None = None
     std: tuple[float, float, float] | None = None
+    channels: dict[str, Tensor] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         b = self.images.shape[0] if self.images.dim() == 4 else -1
@@ -122,6 +127,10 @@ class SceneBatch:
             )
         if a.layout not in (torch.strided, torch.sparse_coo):
             raise DataError(f"adjacency: layout {a.layout}; expected dense or sparse COO")
+        frame = (b, *self.images.shape[2:])
+        for name, t in self.channels.items():
+            if tuple(t.shape) != frame:
+                raise DataError(f"channel {name}: shape {tuple(t.shape)}; expected {frame}")
 
     def __getstate__(self) -> dict[str, Any]:
         # a sparse adjacency travels as its parts (DataLoader workers pickle batches): torch
@@ -162,6 +171,8 @@ class SceneBatch:
             value = getattr(self, f.name)
             if isinstance(value, Tensor):
                 value = value.to(device, non_blocking=non_blocking)
+            elif f.name == "channels":
+                value = {k: t.to(device, non_blocking=non_blocking) for k, t in value.items()}
             moved[f.name] = value
         return SceneBatch(**moved)
 

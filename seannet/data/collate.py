@@ -16,7 +16,7 @@ elsewhere, as :mod:`seannet.data.live_views` does) collate to the same batches.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, overload
 
 import numpy as np
@@ -57,6 +57,9 @@ class ViewTensors:
         num_slots: M.
         mean: per-channel mean (RGB, [0, 1] scale) the model's input is normalised with.
         std: per-channel std, as ``mean``.
+        channels: the view's channels asked of the dataset (:mod:`seannet.data.view_channels`),
+            name -> (S, S) tensor: ``depth`` float32 metres, ``instances`` and ``classes``
+            int64; empty unless asked for.
 
     The adjacency travels sparse (a dense one is 3 x M x M floats, 786 KB at M = 256) and is
     made dense on the model's device; :attr:`adjacency` gives it per view.
@@ -71,6 +74,7 @@ class ViewTensors:
     num_slots: int
     mean: Triple
     std: Triple
+    channels: dict[str, Tensor] = field(default_factory=dict)
 
     @property
     def adjacency(self) -> Tensor:
@@ -132,6 +136,8 @@ class ViewArrays:
         in_range: the edges are known to lie in range (the datasets gather them from
             :func:`~seannet.data.view_inputs.graph_from_columns`, which checks): :meth:`batch`
             skips torch's check of the sparse indices.
+        channels: name -> (n, S, S) array of each channel asked of the dataset (as
+            :class:`ViewTensors`); empty unless asked for.
     """
 
     pixels: np.ndarray
@@ -148,6 +154,7 @@ class ViewArrays:
     std: Triple
     block: int
     in_range: bool = False
+    channels: dict[str, np.ndarray] = field(default_factory=dict)
 
     def __len__(self) -> int:
         return self.pixels.shape[0]
@@ -170,6 +177,9 @@ class ViewArrays:
         sizes = {tuple(v.image.shape) for v in views}
         if len(sizes) > 1 or any(v.image.dtype != torch.uint8 for v in views):
             raise DataError(f"view images {sorted(sizes)}; expected one (3, S, S) uint8 size")
+        names = {tuple(v.channels) for v in views}
+        if len(names) > 1:
+            raise DataError(f"views with channels {sorted(names)} in one batch; expected one")
         n = len(views)
         block = n if block is None else block
         if block < 1 or n % block:
@@ -192,6 +202,9 @@ class ViewArrays:
             mean=first.mean,
             std=first.std,
             block=block,
+            channels={
+                c: torch.stack([v.channels[c] for v in views]).numpy() for c in first.channels
+            },
         )
 
     def view(self, k: int) -> ViewTensors:
@@ -208,6 +221,7 @@ class ViewArrays:
             num_slots=self.num_slots,
             mean=self.mean,
             std=self.std,
+            channels={c: torch.from_numpy(a[k]) for c, a in self.channels.items()},
         )
 
     def batch(self, j: int) -> SceneBatch:
@@ -232,6 +246,7 @@ class ViewArrays:
             adjacency=adjacency,
             mean=self.mean,
             std=self.std,
+            channels={c: torch.from_numpy(a[lo:hi]) for c, a in self.channels.items()},
         )
 
 

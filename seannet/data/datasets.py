@@ -52,9 +52,16 @@ from seannet.data.collate import (
 )
 from seannet.data.image_cache import CachedImages, open_image_cache
 from seannet.data.split_graphs import SplitGraphs, flatten_lists, offsets_of, view_spans
+from seannet.data.view_channels import (
+    check_loader_channels,
+    decode_view_channels,
+    empty_channels,
+    stored_columns,
+)
 from seannet.data.view_inputs import ImageTransform, graph_from_columns, graph_tensors
 from seannet.errors import DataError
 from sgdata.dataset import Dataset, decode_image, observations_schema, read_table
+from sgdata.dataset.storage import image_bytes
 from sgdata.errors import DatasetError, one_line
 
 __all__ = [
@@ -128,17 +135,21 @@ class _Shard:
     """One observation file's view columns, held as Arrow / numpy in one process.
 
     Images stay encoded (PNG/JPEG bytes in the Arrow column) and are decoded on access, or
-    are not read at all (``with_images=False``, when the image cache serves them); the scene
-    graphs are flattened into numpy columns with per-row offsets.
+    are not read at all (``with_images=False``, when the image cache serves them); so do the
+    channel columns named in ``channels`` (none by default). The scene graphs are flattened
+    into numpy columns with per-row offsets.
     """
 
-    def __init__(self, path: Path, *, with_images: bool = True) -> None:
-        columns = _VIEW_COLUMNS if with_images else _VIEW_COLUMNS[1:]
+    def __init__(
+        self, path: Path, *, with_images: bool = True, channels: Sequence[str] = ()
+    ) -> None:
+        columns = [*(_VIEW_COLUMNS if with_images else _VIEW_COLUMNS[1:]), *channels]
         try:
             table = read_table(path, observations_schema(), columns=columns)
         except DatasetError as exc:
             raise DataError(one_line(str(exc))) from None
         self.images = table.column("image") if with_images else None
+        self.channels = {c: table.column(c) for c in channels}
         self.obj_offsets, obj = flatten_lists(
             table.column("objects"), ("instance", "class_id", "slot", "box2d")
         )
@@ -150,6 +161,11 @@ class _Shard:
             obj["box2d"],
         )
         self.src, self.dst, self.type = rel["src"], rel["dst"], rel["type"]
+
+    def channel_cells(self, row: int) -> dict[str, bytes | None]:
+        """Row ``row``'s encoded channel PNGs, column name -> bytes (None where null)."""
+        cells = {c: column[row].as_py() for c, column in self.channels.items()}
+        return {c: None if v is None else image_bytes(v) for c, v in cells.items()}
 
     def __len__(self) -> int:
         return len(self.obj_offsets) - 1
@@ -216,8 +232,10 @@ class _ViewStore:
         transform: ImageTransform,
         images: CachedImages | None = None,
         noise: BoxNoise | None = None,
+        channels: tuple[str, ...] = (),
     ) -> None:
         self.split = split
+        self.channels = channels  # loader channel names (seannet.data.view_channels)
         self.transform = transform
         self.num_slots = int(ds.manifest.num_slots)
         self.noise = noise if noise is not None and noise.active else None
@@ -277,7 +295,11 @@ class _ViewStore:
         self._own()
         shard = self._shards.get(f)
         if shard is None:
-            shard = self._shards[f] = _Shard(Path(self.files[f]), with_images=self.cached is None)
+            shard = self._shards[f] = _Shard(
+                Path(self.files[f]),
+                with_images=self.cached is None,
+                channels=stored_columns(self.channels),
+            )
         return shard
 
     def graphs(self) -> SplitGraphs:
@@ -350,6 +372,9 @@ class _ViewStore:
                 hw[k] = rgb.shape[:2]
                 pixels[k], _ = self.transform.resize(rgb, _NO_BOXES)
             boxes = self.transform.scale_boxes(boxes, np.repeat(hw, np.diff(box_offsets), axis=0))
+        channels = empty_channels(self.channels, len(rows), s)
+        if self.channels:
+            self._gather_channels(rows, channels)
         return ViewArrays(
             pixels=pixels,
             boxes=boxes,
@@ -365,7 +390,25 @@ class _ViewStore:
             std=self.std,
             block=block,
             in_range=True,
+            channels=channels,
         )
+
+    def _gather_channels(self, rows: np.ndarray, out: dict[str, np.ndarray]) -> None:
+        """Views ``rows``' channels decoded, resized to the transform's size, into ``out``."""
+        for k, v in enumerate(rows.tolist()):
+            f = int(np.searchsorted(self.file_starts, v, side="right")) - 1
+            shard = self.shard(f)
+            row = v - int(self.file_starts[f])
+            o0, o1 = shard.obj_offsets[row], shard.obj_offsets[row + 1]
+            decoded = decode_view_channels(
+                shard.channel_cells(row),
+                shard.class_id[o0:o1],
+                self.channels,
+                self.transform.size,
+                where=f"observation {self.obs_ids[v]!r}",
+            )
+            for name, values in decoded.items():
+                out[name][k] = values
 
 
 _NO_BOXES = np.zeros((0, 4), dtype=np.float32)
@@ -396,9 +439,11 @@ def _open_split(
     transform: ImageTransform | None,
     cache: bool | str | Path,
     noise: BoxNoise | None = None,
+    channels: Sequence[str] = (),
 ) -> Dataset:
     """The attributes both datasets share: root, split, transform, identity and view store."""
     ds = open_dataset(root)
+    names = check_loader_channels(ds, channels, root=root)
     target.root = Path(root)
     target.split = split
     target.transform = transform or ImageTransform()
@@ -407,7 +452,7 @@ def _open_split(
     if cache is not False and cache is not None:
         cache_dir = None if cache is True else Path(cache)
         images = open_image_cache(ds, split, target.transform, cache_dir=cache_dir)
-    target._store = _ViewStore(ds, split, target.transform, images, noise)
+    target._store = _ViewStore(ds, split, target.transform, images, noise, names)
     return ds
 
 
@@ -434,10 +479,15 @@ class TripletDataset(TorchDataset):
             of decoding PNG per view: ``True`` for the default cache dir under the dataset
             root, or a directory of the caller's; built on first use, rebuilt when stale.
             Default ``False`` (decode per view).
+        channels: per-view channels to return beside the image, any of ``depth``,
+            ``instances``, ``classes`` (:mod:`seannet.data.view_channels`): each batch's
+            ``SceneBatch.channels`` then holds them as (B, S, S) tensors, resized like the
+            image (nearest neighbour). Read and decoded per view, cache or not. Default none.
 
     Raises:
         DataError: the dataset or split is missing or malformed, a triplet names an
-            observation the split does not hold, or the image cache cannot be used.
+            observation the split does not hold, the image cache cannot be used, or a
+            channel is asked for that the dataset does not store.
     """
 
     def __init__(
@@ -447,8 +497,9 @@ class TripletDataset(TorchDataset):
         *,
         transform: ImageTransform | None = None,
         cache: bool | str | Path = False,
+        channels: Sequence[str] = (),
     ) -> None:
-        ds = _open_split(self, root, split, transform, cache)
+        ds = _open_split(self, root, split, transform, cache, channels=channels)
         table = _call(ds.triplets, split)
         self.triplet_ids = table.column("triplet_id").to_numpy().astype(np.int64)
         self.tiers = table.column("tier").to_numpy().astype(np.int64)
@@ -504,10 +555,12 @@ class ObservationDataset(TorchDataset):
         cache: as for :class:`TripletDataset` (default ``False``: decode per view).
         noise: the boxes as a labeler or detector would give them (:class:`BoxNoise`;
             default: the dataset's own boxes).
+        channels: as for :class:`TripletDataset` (default none); the masks stay the stored
+            ones under ``noise``.
 
     Raises:
-        DataError: the dataset or split is missing or malformed, or the image cache cannot
-            be used.
+        DataError: the dataset or split is missing or malformed, the image cache cannot
+            be used, or a channel is asked for that the dataset does not store.
     """
 
     def __init__(
@@ -518,8 +571,9 @@ class ObservationDataset(TorchDataset):
         transform: ImageTransform | None = None,
         cache: bool | str | Path = False,
         noise: BoxNoise | None = None,
+        channels: Sequence[str] = (),
     ) -> None:
-        _open_split(self, root, split, transform, cache, noise)
+        _open_split(self, root, split, transform, cache, noise, channels)
 
     def __len__(self) -> int:
         return len(self._store.obs_ids)

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import io
 import zlib
+from typing import Any
 
 import numpy as np
 from PIL import Image
@@ -37,12 +38,21 @@ __all__ = [
     "depth_metres",
     "encode_depth",
     "encode_mask",
+    "stored_channels",
 ]
 
 CHANNELS = ("depth", "instances")  # the optional observation columns, in schema order
 CHANNELS_SINCE = "2.1.0"  # the format version that added them
 DEPTH_UNITS_PER_METRE = 1000  # depth PNG values are millimetres
 _UINT16_MAX = np.iinfo(np.uint16).max
+
+
+def stored_channels(config: dict[str, Any] | None) -> tuple[str, ...]:
+    """The channels a dataset's rows carry, from its manifest's resolved ``config`` (its
+    ``[outputs]``), in schema order; none for a config without ``[outputs]`` (real photos,
+    datasets older than :data:`CHANNELS_SINCE`)."""
+    outputs = (config or {}).get("outputs") or {}
+    return tuple(c for c in CHANNELS if outputs.get(c))
 
 
 def _encode_uint16(values: np.ndarray) -> bytes:
