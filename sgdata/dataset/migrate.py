@@ -8,6 +8,8 @@ with :func:`~sgdata.dataset.rows.write_parquet`; the manifest is written last, s
 stops half way leaves a dataset that still reads, and running again finishes it. PNG images of
 a dataset older than :data:`~sgdata.dataset.rows.PNG_STRATEGY_SINCE` are decoded and encoded
 again as ``generate`` now encodes them (lossless: the same pixels); JPEGs are kept as they are.
+Every table is written with the current schema's metadata (its ``format_version``, name and
+field docs): the reader keeps a file's own, which names the old version.
 """
 
 from __future__ import annotations
@@ -69,11 +71,19 @@ def migrate_dataset(root: str | Path) -> Manifest:
             table = read_table(root / entry.path, schema)
             if old_png and "image" in table.column_names:
                 table = _reencode_pngs(table, entry.path)
+            table = _with_current_metadata(table, schema)
             info = write_parquet(table, root / entry.path)
             entry = FileEntry(entry.path, info.rows, info.sha256, info.bytes)
         files.append(entry)
     write_manifest(replace(manifest, format_version=FORMAT_VERSION, files=tuple(files)), root)
     return read_manifest(root)
+
+
+def _with_current_metadata(table: pa.Table, schema: pa.Schema) -> pa.Table:
+    """``table`` (read by :func:`read_table`, so of ``schema``'s columns and types) under the
+    current schema's field and file metadata, not the old file's."""
+    fields = [schema.field(n) for n in table.column_names]
+    return pa.Table.from_arrays(table.columns, schema=pa.schema(fields, metadata=schema.metadata))
 
 
 def _reencode_pngs(table: pa.Table, where: str) -> pa.Table:

@@ -76,8 +76,9 @@ def legacy_dataset(
 ) -> None:
     """Turn a generated dataset into one of an older format, as that sgdata wrote it: without
     the columns later minors added, PNGs
-    deflated the old way and, for 1.x, images as bare bytes (non-null binary, no huggingface
-    metadata), no card, no croissant.json."""
+    deflated the old way, its own ``format_version`` in each table's metadata and, for 1.x,
+    images as bare bytes (non-null binary, no huggingface metadata), no card, no
+    croissant.json."""
     raw = json.loads((root / "dataset.json").read_text())
     bare = version.startswith("1.")
     files = []
@@ -86,6 +87,12 @@ def legacy_dataset(
         if bare and entry["path"] in ("README.md", "croissant.json"):
             path.unlink()
             continue
+        stamp = {b"format_version": version.encode()}
+        if entry["path"].startswith("triplets/"):
+            table = pq.read_table(path)
+            pq.write_table(table.replace_schema_metadata({**table.schema.metadata, **stamp}), path)
+            entry.update(sha256=hashlib.sha256(path.read_bytes()).hexdigest())
+            entry.update(bytes=path.stat().st_size)
         if entry["path"].startswith("observations/"):
             table = pq.read_table(path).drop_columns(list(drop))
             # the columns a later minor added (the channels of 2.1.0) were not there yet
@@ -98,7 +105,7 @@ def legacy_dataset(
             ]
             column = pa.array(old, type=table.schema.field(at).type)
             table = table.set_column(at, table.schema.field(at), column)
-            metadata = table.schema.metadata
+            metadata = {**table.schema.metadata, **stamp}
             if not bare:  # the Image features of the columns that version had
                 hf = file_schema(observations_schema(), version).metadata[b"huggingface"]
                 metadata = {**metadata, b"huggingface": hf}
@@ -406,6 +413,7 @@ def test_a_format_1_1_dataset_reads_validates_and_migrates(copy: Path, mini_data
 
     legacy_dataset(copy)
     assert pq.read_schema(copy / SHARD).field("image").type == pa.binary()
+    assert pq.read_schema(copy / SHARD).metadata[b"format_version"] == b"1.1.0"
     report = validate_dataset(copy)  # images decoded too
     assert report.ok, report.problems[:3]
     assert {"metadata.card", "metadata.croissant"} <= set(report.skipped)
@@ -442,6 +450,10 @@ def test_a_format_2_0_0_dataset_migrates_to_the_bytes_generate_writes(
     legacy_dataset(copy, version="2.0.0")  # the old PNG deflate, everything else as now
     assert validate_dataset(copy).ok
     assert migrate_dataset(copy).format_version == FORMAT_VERSION
+    for entry in read_manifest(copy).files:  # each table says the version it now is
+        if entry.path.endswith(".parquet"):
+            stamp = pq.read_schema(copy / entry.path).metadata[b"format_version"]
+            assert stamp == FORMAT_VERSION.encode(), entry.path
     generated = {f.path: f.sha256 for f in Dataset.open(mini_dataset).manifest.files}
     assert {f.path: f.sha256 for f in read_manifest(copy).files} == generated
 
