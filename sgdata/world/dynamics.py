@@ -373,7 +373,7 @@ class _LayoutSampler:
                 return False
             floor_standing = item.support is None and item.attached_to is None
             others = [*still, self.keepout] if floor_standing else still
-            if colliding(item, others, lookup) is not None:
+            if colliding(item, others, lookup, self.catalog) is not None:
                 return False
         if any(m.support is None and m.attached_to is None for m in moved):
             layout = room.with_objects([lookup[o.instance] for o in room.objects])

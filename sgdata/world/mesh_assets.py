@@ -44,6 +44,7 @@ __all__ = [
     "class_shape",
     "class_sizes",
     "mesh_build",
+    "mesh_footprint",
     "read_asset",
 ]
 
@@ -519,6 +520,17 @@ def mesh_build(
         for s in asset.surfaces
     ]
     return ShapeBuild(parts=parts, surfaces=surfaces)
+
+
+@lru_cache(maxsize=1024)
+def mesh_footprint(spec: ClassSpec, size: tuple[float, float, float], variant: int) -> np.ndarray:
+    """(K, 2) floor outline of variant ``variant`` of a mesh class scaled to ``size``, in the
+    object's local frame: the convex hull of its projection, counter-clockwise (read-only)."""
+    asset = class_assets(spec)[variant % len(spec.mesh.files)]  # type: ignore[union-attr]
+    factor = np.array(size[:2], np.float64) / np.maximum(np.array(asset.size[:2]), 1e-9)
+    outline = np.asarray(asset.footprint, np.float64) * factor
+    outline.flags.writeable = False
+    return outline
 
 
 def class_shape(

@@ -4,6 +4,9 @@ Shared by the room generator and the dynamics sampler, so that a generated room 
 layout of it obey the same rules: inside the room, resting on a support, no interpenetration.
 Collision uses each object's oriented bounding box; an object may overlap the boxes of the
 objects it rests on or is attached to (a book on a shelf lies inside the shelving unit's box).
+A class made of mesh files collides by its floor outline instead (the convex hull of the
+mesh's projection, :func:`floor_outline`) over its box's height, so round plates and bowls
+stand as close as their rims allow; two recipe objects keep the box test.
 """
 
 from __future__ import annotations
@@ -25,7 +28,9 @@ __all__ = [
     "ancestors",
     "boxes_overlap",
     "colliding",
+    "floor_outline",
     "inside_room",
+    "objects_overlap",
     "object_build",
     "place_on_surface",
     "shape_build",
@@ -135,13 +140,67 @@ def _separated(pa: np.ndarray, pb: np.ndarray, eps: float) -> bool:
     return bool(pa.max() - allowance <= pb.min() or pb.max() - allowance <= pa.min())
 
 
+def floor_outline(obj: SceneObject, catalog: Catalog | None = None) -> np.ndarray:
+    """(K, 2) world outline of ``obj`` on the floor, counter-clockwise: the convex hull of a
+    mesh class's projection, else its oriented box's footprint (4 corners)."""
+    spec = catalog[obj.class_name] if catalog is not None and obj.class_name in catalog else None
+    if spec is not None and spec.mesh is not None:
+        from sgdata.world.mesh_assets import mesh_footprint  # late: reads the files once
+
+        local = mesh_footprint(spec, obj.size, obj.variant)
+        if len(local) >= 3:
+            matrix = obj.placement.matrix()
+            return local @ matrix[:2, :2].T + matrix[:2, 3]
+    # corners from SceneObject.corners(): x-major order, so 0, 4, 6, 2 go round the bottom
+    return obj.corners()[[0, 4, 6, 2], :2]
+
+
+def _is_mesh(obj: SceneObject, catalog: Catalog | None) -> bool:
+    return (
+        catalog is not None
+        and obj.class_name in catalog
+        and catalog[obj.class_name].mesh is not None
+    )
+
+
+def objects_overlap(
+    a: SceneObject, b: SceneObject, catalog: Catalog | None = None, eps: float = CONTACT_EPS
+) -> bool:
+    """True when ``a`` and ``b`` interpenetrate by more than ``eps``: their boxes' heights
+    overlap and so do their floor outlines (:func:`floor_outline`; the separating axis test
+    over both convex polygons' edge normals). Two recipe objects (or no ``catalog``) take
+    :func:`boxes_overlap` unchanged."""
+    if not (_is_mesh(a, catalog) or _is_mesh(b, catalog)):
+        return boxes_overlap(a, b, eps)
+    if _separated(a.corners()[:, 2], b.corners()[:, 2], eps):
+        return False
+    pa, pb = floor_outline(a, catalog), floor_outline(b, catalog)
+    return _polygons_overlap(pa, pb, eps)
+
+
+def _polygons_overlap(pa: np.ndarray, pb: np.ndarray, eps: float) -> bool:
+    """Do two convex polygons (K, 2) overlap by more than the contact allowance along every
+    edge normal of either (the separating axis theorem, all axes at once)?"""
+    edges = np.vstack([np.roll(pa, -1, axis=0) - pa, np.roll(pb, -1, axis=0) - pb])
+    length = np.hypot(edges[:, 0], edges[:, 1])
+    edges = edges[length > 1e-12] / length[length > 1e-12, None]
+    axes = np.stack([-edges[:, 1], edges[:, 0]], axis=1)  # (E, 2) unit normals
+    ja, jb = pa @ axes.T, pb @ axes.T  # (Ka, E), (Kb, E)
+    lo_a, hi_a, lo_b, hi_b = ja.min(axis=0), ja.max(axis=0), jb.min(axis=0), jb.max(axis=0)
+    allowance = np.minimum(eps, 0.25 * np.minimum(hi_a - lo_a, hi_b - lo_b))
+    separated = (hi_a - allowance <= lo_b) | (hi_b - allowance <= lo_a)
+    return not bool(separated.any())
+
+
 def colliding(
     candidate: SceneObject,
     others: Iterable[SceneObject],
     by_instance: Mapping[int, SceneObject],
+    catalog: Catalog | None = None,
 ) -> SceneObject | None:
     """The first object in ``others`` that ``candidate`` interpenetrates, ignoring its own
-    support chain and everything resting on or attached to it."""
+    support chain and everything resting on or attached to it. With ``catalog``, mesh
+    classes collide by their floor outlines (:func:`objects_overlap`)."""
     mine = ancestors(candidate, by_instance)
     pool = [
         o
@@ -157,7 +216,7 @@ def colliding(
     own = candidate.corners()
     overlap = (corners.min(axis=1) < own.max(axis=0)) & (corners.max(axis=1) > own.min(axis=0))
     for index in np.nonzero(overlap.all(axis=1))[0]:
-        if boxes_overlap(candidate, pool[index]):
+        if objects_overlap(candidate, pool[index], catalog):
             return pool[index]
     return None
 

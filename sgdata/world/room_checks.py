@@ -8,8 +8,8 @@ from sgdata.world.catalog import Catalog
 from sgdata.world.placement import (
     CONTACT_EPS,
     ancestors,
-    boxes_overlap,
     inside_room,
+    objects_overlap,
     world_surfaces,
 )
 from sgdata.world.scene import Room, SceneObject
@@ -76,7 +76,7 @@ def room_problems(room: Room, catalog: Catalog, *, limit: int = 20) -> list[str]
             b = objects[a_index + 1 + int(offset)]
             if b.instance in lineage[a.instance] or a.instance in lineage[b.instance]:
                 continue
-            if boxes_overlap(a, b):
+            if objects_overlap(a, b, catalog):
                 problems.append(f"{a.prim_name} and {b.prim_name} interpenetrate")
         if len(problems) >= limit:
             break

@@ -182,7 +182,12 @@ class _RoomBuilder:
             return False
         others = [*self.objects, self.keepout]
         return (
-            colliding(candidate, others, {**self.by_instance, candidate.instance: candidate})
+            colliding(
+                candidate,
+                others,
+                {**self.by_instance, candidate.instance: candidate},
+                self.catalog,
+            )
             is None
         )
 
