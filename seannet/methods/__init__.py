@@ -15,6 +15,7 @@ _EXPORTS = {
     "register_method": ".registry",
     "BenchmarkConfig": ".benchmark",
     "benchmark_method": ".benchmark",
+    "MethodLocalizer": ".localizer",
     "leaderboard": ".cards",
     "read_cards": ".cards",
 }

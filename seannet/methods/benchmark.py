@@ -40,6 +40,7 @@ from seannet.errors import MethodError
 from seannet.evaluation.intervals import per_room_matrix, t_interval, two_level_interval
 from seannet.evaluation.retrieval import recall_at_k
 from seannet.methods.change import change_of_pairs, sweep
+from seannet.methods.checks import checked_similarity, checked_vectors, guarded
 from seannet.methods.registry import load_method
 from seannet.methods.views import Budget, SplitData, Views
 
@@ -53,7 +54,6 @@ NOISE_LEVELS = (
     BoxNoise(jitter=0.1, drop=0.1, spurious=0.1),
 )
 _CHUNK = 4096  # pairs per similarity call
-_TOLERANCE = 1e-4  # how far past [-1, 1] a similarity may round
 
 
 @dataclass(frozen=True)
@@ -75,41 +75,6 @@ class BenchmarkConfig:
             raise MethodError("benchmark: name at least one seed")
         if self.batch_size < 1:
             raise MethodError(f"benchmark: batch_size {self.batch_size}; expected >= 1")
-
-
-def _guarded(name: str, what: str, call: Callable[..., Any], *args: Any) -> Any:
-    """``call(*args)``, an exception inside the method becoming one line naming it."""
-    try:
-        return call(*args)
-    except MethodError:
-        raise
-    except Exception as exc:  # noqa: BLE001 - whatever a user's method raises
-        text = " ".join(str(exc).split())[:200]
-        raise MethodError(
-            f"method {name!r}: {what} raised {type(exc).__name__}: {text} (check: no exception)"
-        ) from None
-
-
-def _checked_vectors(name: str, out: Any, n: int, width: int | None) -> Tensor:
-    if not isinstance(out, Tensor):
-        raise MethodError(
-            f"method {name!r}: embed returned {type(out).__name__}; expected a Tensor [N, D] "
-            "(check: type)"
-        )
-    if out.dim() != 2 or out.shape[0] != n or (width is not None and out.shape[1] != width):
-        want = f"[{n}, {width if width is not None else 'D'}]"
-        raise MethodError(
-            f"method {name!r}: embed returned shape {list(out.shape)} for {n} views; expected "
-            f"{want} (check: shape)"
-        )
-    if not out.is_floating_point():
-        raise MethodError(
-            f"method {name!r}: embed returned dtype {out.dtype}; expected a float tensor "
-            "(check: dtype)"
-        )
-    if not bool(torch.isfinite(out).all()):
-        raise MethodError(f"method {name!r}: embed returned NaN or inf (check: finite)")
-    return out.detach().cpu()
 
 
 @dataclass
@@ -150,9 +115,9 @@ class _Harness:
         seconds = 0.0
         for batch, info in self.loader(split, noise):
             start = time.perf_counter()
-            out = _guarded(self.name, "embed", self.method.embed, Views(batch, method=self.name))
+            out = guarded(self.name, "embed", self.method.embed, Views(batch, method=self.name))
             seconds += time.perf_counter() - start
-            out = _checked_vectors(self.name, out, batch.num_views, self.width)
+            out = checked_vectors(self.name, out, batch.num_views, self.width)
             self.width = out.shape[1]
             parts.append(out)
             meta["obs_id"] += info["obs_id"]
@@ -199,23 +164,7 @@ class _Harness:
         for start in range(0, len(first), _CHUNK):
             a = vectors[torch.from_numpy(first[start : start + _CHUNK])]
             b = vectors[torch.from_numpy(second[start : start + _CHUNK])]
-            s = _guarded(self.name, "similarity", self.similarity, a, b)
-            if not isinstance(s, Tensor) or tuple(s.shape) != (len(a),):
-                shape = list(s.shape) if isinstance(s, Tensor) else type(s).__name__
-                raise MethodError(
-                    f"method {self.name!r}: similarity returned {shape} for {len(a)} pairs; "
-                    f"expected a Tensor [{len(a)}] (check: similarity shape)"
-                )
-            s = s.detach().double().cpu()
-            if not bool(torch.isfinite(s).all()):
-                raise MethodError(
-                    f"method {self.name!r}: similarity returned NaN or inf (check: finite)"
-                )
-            if float(s.abs().max()) > 1.0 + _TOLERANCE:
-                raise MethodError(
-                    f"method {self.name!r}: similarity {float(s.abs().max()):.4g} outside "
-                    "[-1, 1], where epsilon and lambda assume a cosine (check: similarity range)"
-                )
+            s = checked_similarity(self.name, self.similarity, a, b)
             out.append(s.numpy())
         return np.concatenate(out)
 
@@ -297,7 +246,7 @@ def _one_seed(
     work: Path, say: Callable[[str], None],
 ) -> dict[str, Any]:  # fmt: skip
     torch.manual_seed(seed)
-    method = _guarded(name, "its factory", factory)
+    method = guarded(name, "its factory", factory)
     if not callable(getattr(method, "embed", None)):
         raise MethodError(f"method {name!r}: has no embed(views) (check: interface)")
     h = _Harness(name, method, data, config)
@@ -306,7 +255,7 @@ def _one_seed(
         say(f"{name}: fit, seed {seed}")
         budget = Budget(seed=seed, preset=config.preset, batches=config.batches,
                         epochs=config.epochs, lrs=config.lrs, work=work)  # fmt: skip
-        _guarded(name, "fit", fit, h.split_data("train"), h.split_data("val"), budget)
+        guarded(name, "fit", fit, h.split_data("train"), h.split_data("val"), budget)
     say(f"{name}: val (epsilon), seed {seed}")
     val = h.embed("val")
     first, second, steps = _pose_pairs(val)

@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 import torch
 
@@ -204,3 +205,23 @@ def test_lite0_with_a_trained_head_chooses_its_lr_on_val(
     choices = card["runs"][0]["choices"]
     assert card["trained"] and set(choices["val_accuracy_by_lr"]) == {"0.01", "0.1"}
     assert card["summary"]["bytes_per_map_entry"] == 256 * 4
+
+
+def test_a_method_localizes_views_for_maps_and_navigation(mini_dataset: Path) -> None:
+    from seannet.data.datasets import ObservationDataset
+    from seannet.methods import MethodLocalizer
+
+    localizer = MethodLocalizer("tiny-image")
+    views = ObservationDataset(mini_dataset, "test", transform=localizer.transform)
+    vectors = localizer.embed([views[k].view for k in range(5)])
+    assert vectors.shape == (5, 768) and np.allclose(np.linalg.norm(vectors, axis=1), 1.0)
+    assert np.allclose(localizer.score(vectors, vectors), 1.0)
+    boxes = MethodLocalizer("boxes-overlap")
+    box_vectors = boxes.embed([views[k].view for k in range(3)])
+    assert (
+        (boxes.score(box_vectors, box_vectors[::-1]) >= 0)
+        & (boxes.score(box_vectors, box_vectors) <= 1)
+    ).all()
+    register_method("test-bad-localizer")(_NaN)
+    with pytest.raises(MethodError, match="test-bad-localizer.*check: finite"):
+        MethodLocalizer("test-bad-localizer").embed([views[0].view])
