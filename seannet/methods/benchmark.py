@@ -99,6 +99,7 @@ class _Harness:
 
     def __init__(self, name: str, method: Any, data: Path, config: BenchmarkConfig) -> None:
         self.name, self.method, self.data, self.config = name, method, data, config
+        self.dataset = open_dataset(data)  # the manifest and triplet tables, read once
         self.width: int | None = None
         self.similarity = getattr(method, "similarity", None)
 
@@ -134,7 +135,7 @@ class _Harness:
     def split_data(self, split: str) -> SplitData:
         views = ObservationDataset(self.data, split)
         index = {o: k for k, o in enumerate(views.obs_ids)}
-        table = open_dataset(self.data).triplets(split)
+        table = self.dataset.triplets(split)
         triplets = np.array(
             [[index[o] for o in row] for row in zip(
                 *(table.column(c).to_pylist() for c in ("anchor", "positive", "negative")),
@@ -223,7 +224,7 @@ def _recall(h: _Harness, e: _Embedded, map_layout: int) -> dict[str, Any]:
 
 def _triplets(h: _Harness, e: _Embedded, split: str) -> tuple[np.ndarray, dict[str, Any]]:
     """Per-triplet correctness on ``split`` and the accuracy overall / per tier / per room."""
-    table = open_dataset(h.data).triplets(split)
+    table = h.dataset.triplets(split)
     index = e.index()
     cols = [table.column(c).to_pylist() for c in ("anchor", "positive", "negative")]
     a, p, n = (np.array([index[o] for o in col], dtype=np.int64) for col in cols)
@@ -280,7 +281,7 @@ def _one_seed(
             "recall": float((same > eps).mean()) if len(same) else float("nan"),
         },
         "retrieval": _recall(h, test, config.map_layout),
-        "change": sweep(correct, change_of_pairs(open_dataset(data), "test", pairs)),
+        "change": sweep(correct, change_of_pairs(h.dataset, "test", pairs)),
         "cost": {
             "ms_per_view": 1000.0 * test.seconds / len(test.obs_ids),
             "bytes_per_map_entry": int(test.vectors.shape[1] * test.vectors.element_size()),
