@@ -19,6 +19,7 @@ import pyarrow as pa
 import pyarrow.compute as pc
 import pyarrow.parquet as pq
 
+from sgdata import markdown
 from sgdata.dataset.paths import CARD, MANIFEST, OBSERVATIONS, TRIPLETS
 from sgdata.dataset.schema import observations_schema, primitive_name, triplets_schema
 from sgdata.dataset.storage import is_image_field
@@ -247,11 +248,6 @@ def _histograms(root: Path, manifest: Manifest) -> tuple[Counter, Counter]:
     return room_types, classes
 
 
-def _table(header: list[str], rows: list[list[Any]]) -> list[str]:
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    return lines + ["| " + " | ".join(str(c) for c in row) + " |" for row in rows]
-
-
 def _body(root: Path, manifest: Manifest) -> list[str]:
     m = manifest
     room_types, classes = _histograms(root, m)
@@ -277,7 +273,7 @@ def _body(root: Path, manifest: Manifest) -> list[str]:
         "",
         "## Counts",
         "",
-        *_table(
+        *markdown.table(
             [
                 "split",
                 "rooms",
@@ -292,11 +288,11 @@ def _body(root: Path, manifest: Manifest) -> list[str]:
             counts,
         ),
         "",
-        *_table(["room type", "views"], [[k, room_types[k]] for k in sorted(room_types)]),
+        *markdown.table(["room type", "views"], [[k, room_types[k]] for k in sorted(room_types)]),
         "",
         "Visible objects per class (over every view):",
         "",
-        *_table(["class", "objects"], [[k, n] for k, n in sorted(classes.items())]),
+        *markdown.table(["class", "objects"], [[k, n] for k, n in sorted(classes.items())]),
         "",
         "`sgdata report ROOT` draws previews and annotated views of this dataset.",
         "",

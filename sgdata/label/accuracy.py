@@ -9,6 +9,7 @@ from sgdata.label.classes import ClassNames
 from sgdata.label.models import PhotoLabels
 from sgdata.label.proposals import RELATION_NAMES, ProposalRules
 from sgdata.label.review import proposals_for
+from sgdata.markdown import table
 
 __all__ = ["ProposalScore", "score_proposals"]
 
@@ -29,17 +30,15 @@ class ProposalScore:
 
     def table(self) -> str:
         """A markdown table: per type, labeled / proposed / both, recall and precision."""
-        lines = [
-            "| relation | labeled | proposed | both | recall | precision |",
-            "|---|---:|---:|---:|---:|---:|",
-        ]
+        rows: list[list[object]] = []
         for kind in RELATION_NAMES:
             n, p, h = self.labeled[kind], self.proposed[kind], self.hits[kind]
             recall = f"{h / n:.0%}" if n else "–"
             precision = f"{h / p:.0%}" if p else "–"
-            lines.append(f"| {kind} | {n} | {p} | {h} | {recall} | {precision} |")
-        lines.append(f"| **all pairs** | {self.pairs} | | {self.agree} | {self.accuracy:.0%} | |")
-        return "\n".join(lines)
+            rows.append([kind, n, p, h, recall, precision])
+        rows.append(["**all pairs**", self.pairs, "", self.agree, f"{self.accuracy:.0%}", ""])
+        header = ("relation", "labeled", "proposed", "both", "recall", "precision")
+        return "\n".join(table(header, rows, right=range(1, 6)))
 
 
 def score_proposals(

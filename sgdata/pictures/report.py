@@ -16,6 +16,7 @@ import numpy as np
 import pyarrow as pa
 from PIL import Image, ImageDraw, ImageFont
 
+from sgdata import markdown
 from sgdata.dataset import Dataset
 
 __all__ = ["write_report", "bar_chart", "channel_sheet", "contact_sheet"]
@@ -215,16 +216,20 @@ def _summary(ds: Dataset, obs: dict[str, pa.Table]) -> str:
         "",
         "## Per split",
         "",
-        "| split | rooms | observations | triplets | tier 0..4 |",
-        "|---|---|---|---|---|",
+        *markdown.table(
+            ("split", "rooms", "observations", "triplets", "tier 0..4"),
+            [
+                [
+                    split,
+                    len(ds.rooms(split)),
+                    obs[split].num_rows,
+                    m.counts.triplets[split],
+                    " / ".join(map(str, m.counts.tiers[split])),
+                ]
+                for split in ds.splits
+            ],
+        ),
     ]
-    for split in ds.splits:
-        tiers = m.counts.tiers[split]
-        lines.append(
-            f"| {split} | {len(ds.rooms(split))} | {obs[split].num_rows} | "
-            f"{m.counts.triplets[split]} | {' / '.join(map(str, tiers))} |"
-        )
-    lines += ["", "## Per room type", "", "| room type | rooms | observations |", "|---|---|---|"]
     by_type_rooms: Counter = Counter()
     by_type_obs: Counter = Counter()
     for split in ds.splits:
@@ -234,35 +239,41 @@ def _summary(ds: Dataset, obs: dict[str, pa.Table]) -> str:
             {(t, r) for t, r in zip(types, obs[split].column("room_id").to_pylist(), strict=True)}
         )
     rooms_per_type = Counter(t for t, _ in by_type_rooms)
-    for t in sorted(by_type_obs):
-        lines.append(f"| {t} | {rooms_per_type[t]} | {by_type_obs[t]} |")
+    lines += [
+        "",
+        "## Per room type",
+        "",
+        *markdown.table(
+            ("room type", "rooms", "observations"),
+            [[t, rooms_per_type[t], by_type_obs[t]] for t in sorted(by_type_obs)],
+        ),
+    ]
+    tiers = [[m.counts.tiers[s][k] for s in ds.splits] for k in range(5)]
     lines += [
         "",
         "## Per tier",
         "",
-        "| tier | " + " | ".join(ds.splits) + " | all |",
-        "|---|" + "---|" * (len(ds.splits) + 1),
+        *markdown.table(
+            ("tier", *ds.splits, "all"), [[k, *per, sum(per)] for k, per in enumerate(tiers)]
+        ),
     ]
-    for k in range(5):
-        per = [m.counts.tiers[s][k] for s in ds.splits]
-        lines.append(f"| {k} | " + " | ".join(map(str, per)) + f" | {sum(per)} |")
-    lines += [
-        "",
-        "## Per view",
-        "",
-        "| split | mean objects | mean relations (all) | mean on / in / proximity |",
-        "|---|---|---|---|",
-    ]
+    per_view = []
     for split in ds.splits:
         t = obs[split]
         n = max(t.num_rows, 1)
         objects = sum(len(o) for o in t.column("objects").to_pylist())
         rels = [e["type"] for r in t.column("relations").to_pylist() for e in r]
         kinds = Counter(rels)
-        lines.append(
-            f"| {split} | {objects / n:.2f} | {len(rels) / n:.2f} | "
-            f"{kinds[0] / n:.2f} / {kinds[1] / n:.2f} / {kinds[2] / n:.2f} |"
+        per_view.append(
+            [
+                split,
+                f"{objects / n:.2f}",
+                f"{len(rels) / n:.2f}",
+                f"{kinds[0] / n:.2f} / {kinds[1] / n:.2f} / {kinds[2] / n:.2f}",
+            ]
         )
+    header = ("split", "mean objects", "mean relations (all)", "mean on / in / proximity")
+    lines += ["", "## Per view", "", *markdown.table(header, per_view)]
     return "\n".join(lines) + "\n"
 
 
