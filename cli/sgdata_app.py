@@ -183,14 +183,20 @@ def generate(
     ] = None,
     resume: Annotated[bool, typer.Option(help="Continue an interrupted run in OUT.")] = False,
     force: Annotated[bool, typer.Option(help="Overwrite what a previous run left in OUT.")] = False,
+    profile: Annotated[
+        bool,
+        typer.Option(help="Time every stage of the room tasks and print where the time went."),
+    ] = False,
 ) -> None:
     """Generate a dataset: rooms, layouts, rendered views, cascaded triplets, Parquet."""
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
     from sgdata.pipeline.config import load_config
     from sgdata.pipeline.generate import generate_dataset
+    from sgdata.stage_clock import StageClock
 
     settings = load_config(config)
+    clock = StageClock() if profile else None
     workers = workers or os.cpu_count() or 1
     columns = (
         TextColumn("{task.description:<7}"),
@@ -217,6 +223,7 @@ def generate(
             resume=resume,
             force=force,
             progress=show,
+            clock=clock,
         )
     counts = manifest["counts"]
     table = Table(title=f"{manifest['name']} {manifest['version']} in {out}")
@@ -228,6 +235,26 @@ def generate(
             str(len(rooms)),
             str(counts["observations"][split]),
             str(counts["triplets"][split]),
+        )
+    console.print(table)
+    if clock is not None:
+        _print_stages(clock)
+
+
+def _print_stages(clock) -> None:  # noqa: ANN001
+    """The stage table of a profiled run: seconds summed over its workers, share per phase."""
+    from sgdata.pipeline.room_tasks import stage_order
+
+    table = Table(title="where the time went (summed over workers)")
+    for column in ("phase", "stage", "calls", "seconds", "share"):
+        table.add_column(column, justify="left" if column in ("phase", "stage") else "right")
+    for row in clock.rows(stage_order()):
+        table.add_row(
+            row["phase"],
+            row["stage"],
+            str(row["calls"]),
+            f"{row['seconds']:.2f}",
+            f"{100 * row['share']:.1f} %",
         )
     console.print(table)
 

@@ -1,4 +1,5 @@
-"""Loading a script of bench/ as a module, for the tests of its tables and verbs."""
+"""Loading a script of bench/ as a module: the one way tests of bench scripts (tests/bench/)
+load them, for their tables and verbs."""
 
 from __future__ import annotations
 
@@ -6,7 +7,8 @@ import importlib.util
 from pathlib import Path
 from types import ModuleType
 
-BENCH = Path(__file__).resolve().parents[1] / "bench"
+ROOT = Path(__file__).resolve().parents[1]
+BENCH = ROOT / "bench"
 
 
 def load_bench(name: str) -> ModuleType:

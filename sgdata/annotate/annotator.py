@@ -15,10 +15,14 @@ from sgdata.annotate.slots import SlotTable
 from sgdata.errors import RenderError
 from sgdata.render.camera import CameraConfig
 from sgdata.render.renderer import Renderer
+from sgdata.stage_clock import NO_CLOCK, Clock
 from sgdata.usd.meshes import Lighting, SceneGeometry
 from sgdata.world.scene import Room
 
-__all__ = ["ViewAnnotator"]
+__all__ = ["VIEW_STEPS", "ViewAnnotator"]
+
+# The steps of a view a clock times (:mod:`sgdata.stage_clock`), in order.
+VIEW_STEPS = ("render", "boxes", "slots", "relations")
 
 
 class ViewAnnotator:
@@ -32,6 +36,8 @@ class ViewAnnotator:
         keep_depth: keep the depth image in the records (metres along the view axis).
         keep_instances: keep the instance mask in the records
             (:meth:`~sgdata.annotate.boxes.Annotation.instance_mask`).
+        clock: times the steps of each view as :data:`VIEW_STEPS` (default: no clock); a
+            profiled room task sets it for its views.
     """
 
     def __init__(
@@ -43,8 +49,10 @@ class ViewAnnotator:
         rules: RelationRules | None = None,
         keep_depth: bool = False,
         keep_instances: bool = False,
+        clock: Clock = NO_CLOCK,
     ) -> None:
         self.renderer = renderer
+        self.clock = clock
         self.slots = slots
         self.min_visible_pixels = int(min_visible_pixels)
         self.rules = rules or RelationRules()
@@ -82,11 +90,17 @@ class ViewAnnotator:
             raise RenderError("no layout loaded: call ViewAnnotator.set_layout first")
         table, cam = self._table, self.camera
         rng = np.random.default_rng(seed) if jitter_lights else None
-        rendered = self.renderer.render(pose.x, pose.y, pose.theta, rng=rng, depth=self.keep_depth)
-        ann = annotate(rendered, table, min_visible_pixels=self.min_visible_pixels)
+        clock = self.clock
+        with clock.stage("render"):
+            rendered = self.renderer.render(
+                pose.x, pose.y, pose.theta, rng=rng, depth=self.keep_depth
+            )
+        with clock.stage("boxes"):
+            ann = annotate(rendered, table, min_visible_pixels=self.min_visible_pixels)
         rows = ann.rows
         classes = [table.class_name[r] for r in rows]
-        assignment = self.slots.assign(list(zip(ann.instance.tolist(), classes, strict=True)))
+        with clock.stage("slots"):
+            assignment = self.slots.assign(list(zip(ann.instance.tolist(), classes, strict=True)))
         keep = assignment.slots >= 0
         if not keep.all():
             rows, classes = rows[keep], [c for c, k in zip(classes, keep, strict=True) if k]
@@ -94,10 +108,11 @@ class ViewAnnotator:
         visible = ann.visible_pixels[keep] if not keep.all() else ann.visible_pixels
         # Relations are decided on exactly the boxes the dataset stores (float32), so that
         # `sgdata validate` recomputes every pair with no allowance and agrees.
-        lo, hi = (stored_precision(b[rows]) for b in (table.aabb_min, table.aabb_max))
-        sup = table.support[rows]
-        inst = table.instance[rows]
-        rel = compute_relations(inst, lo, hi, sup, rules=self.rules)
+        with clock.stage("relations"):
+            lo, hi = (stored_precision(b[rows]) for b in (table.aabb_min, table.aabb_max))
+            sup = table.support[rows]
+            inst = table.instance[rows]
+            rel = compute_relations(inst, lo, hi, sup, rules=self.rules)
         return ViewRecord(
             room_id=self._room.room_id,
             layout=self._layout,

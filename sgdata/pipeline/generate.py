@@ -36,6 +36,7 @@ from sgdata.pipeline.ledger import (
 )
 from sgdata.pipeline.room_tasks import RoomTask
 from sgdata.seeds import split_triplets_seed
+from sgdata.stage_clock import StageClock
 from sgdata.world.room_recipes import ROOM_TYPES
 from sgdata.world.triplets import RoomPoses, Triplet, referenced_poses_by_room, sample_triplets
 
@@ -80,8 +81,13 @@ def generate_dataset(
     resume: bool = False,
     force: bool = False,
     progress: Callable[[GenerateProgress], None] | None = None,
+    clock: StageClock | None = None,
 ) -> dict:
     """Generate the dataset described by ``config`` into ``root``; returns the manifest dict.
+
+    With a ``clock`` every room task times its stages (:func:`sgdata.pipeline.room_tasks.
+    stage_order`) on a clock of its own, added to ``clock`` as it finishes (``sgdata generate
+    --profile``); the bytes written are the same.
 
     ``executor`` is ``local`` (spawned processes) or ``ray`` (``address`` joins a cluster,
     without it a local instance); the bytes written are the same whatever runs them.
@@ -115,7 +121,7 @@ def generate_dataset(
     _prepare_root(root, config, resume=resume, force=force)
     with executor_session(executor, workers=workers, address=address):
         engine = {"workers": workers, "executor": executor, "address": address}
-        return _generate(config, root, engine, progress)
+        return _generate(config, root, engine, progress, clock)
 
 
 def _generate(
@@ -123,10 +129,11 @@ def _generate(
     root: Path,
     engine: dict,
     progress: Callable[[GenerateProgress], None] | None,
+    clock: StageClock | None,
 ) -> dict:
     tasks = plan_rooms(config)
     scene_jobs = [t for t in tasks if not scene_record(root, t.room_id).exists()]
-    _run_phase("scenes", scene_jobs, len(tasks), config, root, engine, progress)
+    _run_phase("scenes", scene_jobs, len(tasks), config, root, engine, progress, clock)
     grids = {t.room_id: read_record(scene_record(root, t.room_id)) for t in tasks}
 
     triplets = {split: _split_triplets(config, split, tasks, grids) for split in SPLITS}
@@ -134,7 +141,7 @@ def _generate(
     view_jobs = [
         (t, poses.get(t.room_id, [])) for t in tasks if not views_record(root, t.room_id).exists()
     ]
-    _run_phase("views", view_jobs, len(tasks), config, root, engine, progress)
+    _run_phase("views", view_jobs, len(tasks), config, root, engine, progress, clock)
 
     shards = [read_record(views_record(root, t.room_id)) for t in tasks]
     return _finish(root, config, tasks, shards, triplets)
@@ -264,6 +271,7 @@ def _run_phase(
     root: Path,
     engine: dict,
     progress: Callable[[GenerateProgress], None] | None,
+    clock: StageClock | None,
 ) -> None:
     from sgdata.pipeline.room_tasks import render_room_views, write_room_scenes
 
@@ -271,16 +279,23 @@ def _run_phase(
     done = total - len(jobs)
     views = 0
     if phase == "scenes":
-        payloads = [(task, config, root) for task in jobs]
+        payloads = [(task, config, root, _task_clock(clock)) for task in jobs]
         fn = write_room_scenes
     else:
-        payloads = [(task, list(poses), config, root) for task, poses in jobs]
+        payloads = [(task, list(poses), config, root, _task_clock(clock)) for task, poses in jobs]
         fn = render_room_views
     for result in run_tasks(fn, payloads, **engine):
         done += 1
         views += int(result.get("views", 0))
+        if clock is not None:
+            clock.add(result.get("stages", {}))
         if progress is not None:
             progress(GenerateProgress(phase, done, total, views, time.perf_counter() - start))
+
+
+def _task_clock(clock: StageClock | None) -> StageClock | None:
+    """A fresh clock for one task of a profiled run (it travels to the worker and back)."""
+    return None if clock is None else StageClock()
 
 
 def _split_triplets(

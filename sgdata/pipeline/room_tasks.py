@@ -17,12 +17,31 @@ from sgdata.errors import DatasetError
 from sgdata.pipeline.ledger import read_record, scene_record, views_record, write_record
 from sgdata.scene_files import layout_file, room_file
 from sgdata.seeds import rng_for, view_seed
+from sgdata.stage_clock import NO_CLOCK, OTHER, Clock, StageClock
 
 if TYPE_CHECKING:
     from sgdata.pipeline.config import GenerateConfig
     from sgdata.world.triplets import PoseKey
 
-__all__ = ["RoomTask", "write_room_scenes", "render_room_views"]
+__all__ = ["RoomTask", "render_room_views", "stage_order", "write_room_scenes"]
+
+SCENES, VIEWS = "scenes", "views"  # the phases of generate that run room tasks
+# The stages each task books to its clock, in pipeline order; the annotator's own steps come
+# in the views phase before "view record" (the rest of a view).
+SCENE_STAGES = ("catalog", "room", "room USD", "layouts", "USD read", "pose grid", "ledger", OTHER)
+VIEW_STAGES = ("renderer start", "USD load", "scene build", "pose grid", "view record")
+VIEW_TAIL = ("rows + image encode", "Parquet write", "ledger", OTHER)
+
+
+def stage_order() -> dict[str, tuple[str, ...]]:
+    """The phases of a profiled run and their stages in pipeline order (for its table)."""
+    from sgdata.annotate.annotator import VIEW_STEPS  # late: it loads the renderer
+
+    return {
+        SCENES: SCENE_STAGES,
+        VIEWS: (*VIEW_STAGES[:-1], *VIEW_STEPS, VIEW_STAGES[-1], *VIEW_TAIL),
+    }
+
 
 # One renderer per worker process, kept alive across rooms (built on first use).
 _worker: dict[str, Any] = {}
@@ -42,44 +61,64 @@ class RoomTask:
         return self.name or f"{self.room_type}_{self.index:03d}"
 
 
-def write_room_scenes(task: RoomTask, config: GenerateConfig, root: Path) -> dict:
-    """Phase 1 of a room: USD room and layouts, and the reachable cells of every layout."""
+def write_room_scenes(
+    task: RoomTask, config: GenerateConfig, root: Path, clock: Clock | None = None
+) -> dict:
+    """Phase 1 of a room: USD room and layouts, and the reachable cells of every layout.
+
+    With a ``clock`` (:class:`sgdata.stage_clock.StageClock`) its steps are timed as
+    :func:`stage_order` and the result carries the clock's totals under ``"stages"``.
+    """
+    clock = clock or NO_CLOCK
+    with clock.phase(SCENES), clock.stage(OTHER):
+        _write_room_scenes(task, config, root, clock)
+    return {"views": 0, **_stages(clock)}
+
+
+def _write_room_scenes(task: RoomTask, config: GenerateConfig, root: Path, clock: Clock) -> None:
     from sgdata.pipeline.user_rooms import copy_user_room
     from sgdata.usd.room_io import catalog_geometry, read_room, write_room
     from sgdata.usd.scene_dirs import write_layouts
     from sgdata.world.rooms import generate_room
 
-    catalog = config.catalog.load()
+    with clock.stage("catalog"):
+        catalog = config.catalog.load()
     room_dir = scene_dir(root, task.room_id)
     if task.name:  # a user's room: its stage copied in, tagged
         entry = config.rooms.files[task.index]
-        room = _guarded(lambda: copy_user_room(entry, config, room_dir))
+        with clock.stage("room USD"):
+            room = _guarded(lambda: copy_user_room(entry, config, room_dir))
     else:
-        room = generate_room(task.room_type, task.index, config.dataset.seed, catalog)
-        _guarded(
-            lambda: write_room(
-                room,
-                room_file(room_dir),
-                geometry=catalog_geometry(catalog),
+        with clock.stage("room"):
+            room = generate_room(task.room_type, task.index, config.dataset.seed, catalog)
+        with clock.stage("room USD"):
+            _guarded(
+                lambda: write_room(
+                    room,
+                    room_file(room_dir),
+                    geometry=catalog_geometry(catalog),
+                    appearance=config.appearance,
+                )
+            )
+    with clock.stage("layouts"):
+        layouts = _guarded(
+            lambda: write_layouts(
+                room_dir,
+                count=config.layouts.count,
+                seed=0,
+                catalog=catalog,
+                config=config.dynamics,
+                poses=config.poses,
                 appearance=config.appearance,
             )
         )
-    layouts = _guarded(
-        lambda: write_layouts(
-            room_dir,
-            count=config.layouts.count,
-            seed=0,
-            catalog=catalog,
-            config=config.dynamics,
-            poses=config.poses,
-            appearance=config.appearance,
-        )
-    )
     reachable = {}
     for layout in layouts:
         # the grid of the room as stored, exactly what the renderer will load
-        stored = read_room(layout_file(room_dir, layout.index))
-        grid = config.poses.grid(stored)
+        with clock.stage("USD read"):
+            stored = read_room(layout_file(room_dir, layout.index))
+        with clock.stage("pose grid"):
+            grid = config.poses.grid(stored)
         reachable[str(layout.index)] = [list(c) for c in grid.cells]
     record = {
         "room_id": task.room_id,
@@ -88,53 +127,87 @@ def write_room_scenes(task: RoomTask, config: GenerateConfig, root: Path) -> dic
         "seed": room.seed,
         "reachable": reachable,
     }
-    write_record(scene_record(root, task.room_id), record)
-    return {"views": 0}
+    with clock.stage("ledger"):
+        write_record(scene_record(root, task.room_id), record)
 
 
 def render_room_views(
-    task: RoomTask, poses: list[PoseKey], config: GenerateConfig, root: Path
+    task: RoomTask,
+    poses: list[PoseKey],
+    config: GenerateConfig,
+    root: Path,
+    clock: Clock | None = None,
 ) -> dict:
-    """Phase 3 of a room: render the referenced views and write the room's shard."""
+    """Phase 3 of a room: render the referenced views and write the room's shard.
+
+    With a ``clock`` its steps are timed as :func:`stage_order` (the annotator's too) and the
+    result carries the clock's totals under ``"stages"``.
+    """
+    clock = clock or NO_CLOCK
+    with clock.phase(VIEWS), clock.stage(OTHER):
+        views = _render_room_views(task, poses, config, root, clock)
+    return {"views": views, **_stages(clock)}
+
+
+def _render_room_views(
+    task: RoomTask, poses: list[PoseKey], config: GenerateConfig, root: Path, clock: Clock
+) -> int:
     from sgdata.annotate.records import ViewPose
     from sgdata.dataset.rows import observation_table, write_parquet
     from sgdata.usd.geometry import read_geometry
     from sgdata.usd.room_io import read_room
 
-    annotator, class_ids = _annotator(config)
+    with clock.stage("renderer start"):
+        annotator, class_ids = _annotator(config)
+    annotator.clock = clock
     room_dir = scene_dir(root, task.room_id)
     room_seed = read_record(scene_record(root, task.room_id))["seed"]
     by_layout: dict[int, list[PoseKey]] = defaultdict(list)
     for key in poses:
         by_layout[key.layout].append(key)
     records, scene_paths = [], []
-    for layout in sorted(by_layout):
-        path = layout_file(room_dir, layout)
-        room = read_room(path)
-        annotator.set_layout(room, read_geometry(path), layout)
-        grid = config.poses.grid(room)
-        for key in sorted(by_layout[layout]):
-            seed = view_seed(room_seed, key.layout, key.i, key.j, key.heading)
-            noise = rng_for(seed) if config.poses.noise else None
-            x, y, theta = grid.pose_world(key.i, key.j, key.heading, rng=noise)
-            records.append(
-                annotator.view(ViewPose(x, y, theta, key.i, key.j, key.heading), seed=seed)
-            )
-            scene_paths.append(path.relative_to(root).as_posix())
-    table = observation_table(
-        records,
-        room_type=task.room_type,
-        split=task.split,
-        scene_paths=scene_paths,
-        image_format=config.images.format,
-        jpeg_quality=config.images.jpeg_quality,
-        class_ids=class_ids,
-    )
+    try:
+        for layout in sorted(by_layout):
+            path = layout_file(room_dir, layout)
+            with clock.stage("USD load"):
+                room = read_room(path)
+                geometry = read_geometry(path)
+            with clock.stage("scene build"):
+                annotator.set_layout(room, geometry, layout)
+            with clock.stage("pose grid"):
+                grid = config.poses.grid(room)
+            for key in sorted(by_layout[layout]):
+                seed = view_seed(room_seed, key.layout, key.i, key.j, key.heading)
+                noise = rng_for(seed) if config.poses.noise else None
+                x, y, theta = grid.pose_world(key.i, key.j, key.heading, rng=noise)
+                with clock.stage("view record"):
+                    pose = ViewPose(x, y, theta, key.i, key.j, key.heading)
+                    records.append(annotator.view(pose, seed=seed))
+                scene_paths.append(path.relative_to(root).as_posix())
+    finally:
+        annotator.clock = NO_CLOCK  # the worker's annotator outlives this task
+    with clock.stage("rows + image encode"):
+        table = observation_table(
+            records,
+            room_type=task.room_type,
+            split=task.split,
+            scene_paths=scene_paths,
+            image_format=config.images.format,
+            jpeg_quality=config.images.jpeg_quality,
+            class_ids=class_ids,
+        )
     relative = observations_path(task.split, task.room_id)
-    rows, sha256, size = _guarded(lambda: write_parquet(table, root / relative))
+    with clock.stage("Parquet write"):
+        rows, sha256, size = _guarded(lambda: write_parquet(table, root / relative))
     record = {"path": relative, "rows": rows, "sha256": sha256, "bytes": size}
-    write_record(views_record(root, task.room_id), record)
-    return {"views": len(records)}
+    with clock.stage("ledger"):
+        write_record(views_record(root, task.room_id), record)
+    return len(records)
+
+
+def _stages(clock: Clock) -> dict:
+    """A result's ``"stages"`` entry: the clock's totals, if it keeps any."""
+    return {"stages": clock.totals()} if isinstance(clock, StageClock) else {}
 
 
 def _annotator(config: GenerateConfig) -> tuple[Any, dict[str, int]]:

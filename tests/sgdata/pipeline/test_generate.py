@@ -19,6 +19,8 @@ from sgdata.dataset import Dataset
 from sgdata.errors import ConfigError, DatasetError
 from sgdata.pipeline.config import load_config
 from sgdata.pipeline.generate import LEDGER, generate_dataset
+from sgdata.pipeline.room_tasks import stage_order
+from sgdata.stage_clock import StageClock
 from sgdata.world.triplets import tier_counts
 
 
@@ -31,12 +33,19 @@ def digest_tree(root: Path) -> dict[str, str]:
     }
 
 
-def test_worker_count_does_not_change_bytes(
+def test_neither_worker_count_nor_profiling_changes_bytes(
     tmp_path: Path, mini_dataset: Path, mini_config_file: Path
 ) -> None:
-    other = tmp_path / "two"
-    generate_dataset(load_config(mini_config_file), other, workers=2)
+    other, clock = tmp_path / "one", StageClock()
+    generate_dataset(load_config(mini_config_file), other, workers=1, clock=clock)
     assert digest_tree(other) == digest_tree(mini_dataset)
+    # every room task timed itself in its worker and sent its clock back
+    rows = {(r["phase"], r["stage"]): r for r in clock.rows(stage_order())}
+    rooms = sum(len(r) for r in Dataset.open(other).manifest.splits.values())
+    assert rows[("scenes", "ledger")]["calls"] == rows[("views", "ledger")]["calls"] == rooms
+    views = sum(pq.read_metadata(p).num_rows for p in (other / "observations").rglob("*.parquet"))
+    assert rows[("views", "render")]["calls"] == views
+    assert list(rows) == [k for k in rows if k[1] in stage_order()[k[0]]]  # known, in order
 
 
 def test_composition_and_offsets(mini_triplets: dict[str, int], mini_dataset: Path) -> None:
