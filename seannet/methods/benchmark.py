@@ -38,7 +38,6 @@ from seannet.data.box_noise import BoxNoise
 from seannet.data.datasets import ImageTransform, ObservationDataset, collate_views, open_dataset
 from seannet.errors import MethodError
 from seannet.evaluation.intervals import per_room_matrix, t_interval, two_level_interval
-from seannet.evaluation.retrieval import recall_at_k
 from seannet.methods.change import change_of_pairs, sweep
 from seannet.methods.checks import checked_similarity, checked_vectors, guarded
 from seannet.methods.registry import load_method
@@ -198,8 +197,9 @@ def _choose_epsilon(same: np.ndarray, step: np.ndarray) -> dict[str, float]:
 
 
 def _recall(h: _Harness, e: _Embedded, map_layout: int) -> dict[str, Any]:
-    """recall@1 / @5 of the same pose among the room's map-layout views (other layouts ask)."""
-    hits: dict[int, list[float]] = {1: [], 5: []}
+    """recall@1 / @5 of the same pose among the room's map-layout views (other layouts ask),
+    and each query's hit@1 with its (query, true map view) pair, for the change sweep."""
+    ranks, pairs = [], []
     for room in sorted(set(e.room)):
         in_room = e.room == room
         map_idx = np.nonzero(in_room & (e.layout == map_layout))[0]
@@ -211,14 +211,18 @@ def _recall(h: _Harness, e: _Embedded, map_layout: int) -> dict[str, Any]:
         ]
         if not queries:
             continue
-        q = np.array([k for k, _ in queries])
+        q, truth = np.array([k for k, _ in queries]), np.array([t for _, t in queries])
         first, second = np.repeat(q, len(map_idx)), np.tile(map_idx, len(q))
         sim = h.scores(e.vectors, first, second).reshape(len(q), len(map_idx))
-        for k, value in recall_at_k(sim, np.array([t for _, t in queries])).items():
-            hits[k] += [value] * len(q)
+        true_score = sim[np.arange(len(q)), truth]
+        ranks.append((sim >= true_score[:, None]).sum(axis=1) - 1)  # ties count against
+        pairs += [(e.obs_ids[k], e.obs_ids[map_idx[t]]) for k, t in queries]
+    rank = np.concatenate(ranks) if ranks else np.zeros(0, np.int64)
     return {
-        "recall": {k: float(np.mean(v)) if v else float("nan") for k, v in hits.items()},
-        "queries": len(hits[1]),
+        "recall": {k: float((rank < k).mean()) if len(rank) else float("nan") for k in (1, 5)},
+        "queries": int(len(rank)),
+        "_hits": rank < 1,
+        "_pairs": pairs,
     }
 
 
@@ -271,6 +275,8 @@ def _one_seed(
     eps = threshold["epsilon"]
     same, step = s[steps == 0], s[steps == 1]
     positives = float((same > eps).sum() + (step > eps).sum())
+    retrieval = _recall(h, test, config.map_layout)
+    hits, recall_pairs = retrieval.pop("_hits"), retrieval.pop("_pairs")
     result: dict[str, Any] = {
         "seed": seed,
         "trained": fit is not None,
@@ -280,8 +286,10 @@ def _one_seed(
             "precision": float((same > eps).sum()) / positives if positives else float("nan"),
             "recall": float((same > eps).mean()) if len(same) else float("nan"),
         },
-        "retrieval": _recall(h, test, config.map_layout),
+        "retrieval": retrieval,
         "change": sweep(correct, change_of_pairs(h.dataset, "test", pairs)),
+        # recall@1 of each query against how much moved between it and its true map view
+        "change_recall": sweep(hits, change_of_pairs(h.dataset, "test", recall_pairs)),
         "cost": {
             "ms_per_view": 1000.0 * test.seconds / len(test.obs_ids),
             "bytes_per_map_entry": int(test.vectors.shape[1] * test.vectors.element_size()),
@@ -311,12 +319,14 @@ def breaking_point(by_bin: dict[str, dict[str, float]]) -> str | None:
     return next((k for k, acc in bins[1:] if acc < line), None)
 
 
-def _mean_bins(runs: list[dict[str, Any]], measure: str) -> dict[str, dict[str, float]]:
-    first = runs[0]["change"][measure]
+def _mean_bins(
+    runs: list[dict[str, Any]], measure: str, key: str = "change"
+) -> dict[str, dict[str, float]]:
+    first = runs[0][key][measure]
     return {
         b: {
             "triplets": first[b]["triplets"],
-            "accuracy": float(np.mean([r["change"][measure][b]["accuracy"] for r in runs])),
+            "accuracy": float(np.mean([r[key][measure][b]["accuracy"] for r in runs])),
         }
         for b in first
     }
@@ -328,6 +338,7 @@ def summarize(runs: list[dict[str, Any]]) -> dict[str, Any]:
     rooms = sorted(runs[0]["per_room"])
     weight = np.array([runs[0]["room_triplets"][r] for r in rooms], dtype=np.float64)
     change = {m: _mean_bins(runs, m) for m in runs[0]["change"]}
+    change_recall = {m: _mean_bins(runs, m, "change_recall") for m in runs[0]["change_recall"]}
     summary: dict[str, Any] = {
         "seeds": len(runs),
         "accuracy": t_interval([r["accuracy"] for r in runs]),
@@ -339,6 +350,7 @@ def summarize(runs: list[dict[str, Any]]) -> dict[str, Any]:
             t: float(np.mean([r["per_tier"][t] for r in runs])) for t in runs[0]["per_tier"]
         },  # fmt: skip
         "change": change,
+        "change_recall": change_recall,
         "breaks_at": {m: breaking_point(v) for m, v in change.items() if m != "moved_dynamics"},
         "ms_per_view": float(np.mean([r["cost"]["ms_per_view"] for r in runs])),
         "bytes_per_map_entry": runs[0]["cost"]["bytes_per_map_entry"],

@@ -70,6 +70,15 @@ def _markdown(card: dict[str, Any]) -> str:
         lines += table(
             list(bins), [[f"{pct(v['accuracy'])} ({v['triplets']})" for v in bins.values()]]
         )
+    for measure, bins in s.get("change_recall", {}).items():
+        lines += [
+            "",
+            f"Recall@1 by {measure.replace('_', ' ')} (query vs its map view; %, queries):",
+            "",
+        ]
+        lines += table(
+            list(bins), [[f"{pct(v['accuracy'])} ({v['triplets']})" for v in bins.values()]]
+        )
     if "box_noise" in s:
         lines += ["", "Box noise (S jitter, P drop, Q spurious; accuracy %):", ""]
         lines += table(

@@ -72,7 +72,8 @@ def change_of_pairs(dataset: Dataset, split: str, pairs: Sequence[tuple[str, str
 
 
 def sweep(correct: np.ndarray, change: Change) -> dict[str, dict[str, dict[str, float]]]:
-    """Accuracy and count per bin of each change measure."""
+    """The share of ``correct`` (a triplet ranked right, a query found) and the count per bin
+    of each change measure (the count is named ``triplets`` for either)."""
     keys = {
         "moved_objects": ([moved_bin(int(m)) for m in change.moved], BIN_NAMES),
         "moved_share": ([share_bin(float(s)) for s in change.share], [n for n, _ in SHARE_BINS]),

@@ -151,6 +151,8 @@ def test_reference_methods_get_cards_and_a_leaderboard(tmp_path: Path, mini_data
         sum(b["triplets"] for b in summary["change"]["moved_objects"].values())
         == (summary["triplets"])
     )
+    recall = summary["change_recall"]["moved_objects"]
+    assert sum(b["triplets"] for b in recall.values()) == summary["queries"]  # every query
     assert len(summary["box_noise"]) == len(config.noise)  # boxes: the noise sweep ran
     assert summary["bytes_per_map_entry"] > 0 and summary["ms_per_view"] > 0
     tiny = json.loads((tmp_path / "tiny-image" / "card.json").read_text())["summary"]
