@@ -36,6 +36,8 @@ __all__ = [
     "classes_from_slots",
     "file_entry",
     "relation_type_names",
+    "manifest_bytes",
+    "parse_manifest",
     "read_manifest",
 ]
 
@@ -342,14 +344,32 @@ def read_manifest(root: Path) -> Manifest:
     Raises:
         DatasetError: no ``dataset.json`` (an unfinished or foreign directory), or invalid.
     """
+    return parse_manifest(manifest_bytes(root), Path(root) / MANIFEST)
+
+
+def manifest_bytes(root: Path) -> bytes:
+    """The bytes of ``root/dataset.json`` as stored (what its sha256 covers), read once.
+
+    Raises:
+        DatasetError: no ``dataset.json`` (an unfinished or foreign directory).
+    """
     path = Path(root) / MANIFEST
     if not path.is_file():
         raise DatasetError(
             f"{root}: no {MANIFEST}; not an sgdata dataset "
             "(or generation did not finish: run sgdata generate --resume)"
         )
+    return path.read_bytes()
+
+
+def parse_manifest(raw: bytes, path: Path) -> Manifest:
+    """The validated manifest from the bytes of ``path`` (:func:`manifest_bytes`).
+
+    Raises:
+        DatasetError: not UTF-8 text, or not a valid manifest.
+    """
     try:
-        text = path.read_text(encoding="utf-8")
+        text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:
         raise DatasetError(
             f"{path}: not UTF-8 text ({exc.reason} at byte {exc.start}); expected the JSON "

@@ -6,6 +6,7 @@ need no sgdata code at all (see docs/dataset.md for pyarrow, polars, DuckDB and 
 
 from __future__ import annotations
 
+import hashlib
 import io
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -15,7 +16,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 from PIL import Image
 
-from sgdata.dataset.manifest import Manifest, read_manifest
+from sgdata.dataset.manifest import Manifest, manifest_bytes, parse_manifest
 from sgdata.dataset.paths import MANIFEST, observations_path, triplets_path
 from sgdata.dataset.schema import FORMAT_VERSION, observations_schema, since, triplets_schema
 from sgdata.dataset.storage import image_bytes, is_image_field, memory_column
@@ -129,13 +130,18 @@ class Dataset:
     with ``.to_pandas()`` or ``polars.from_arrow`` as needed.
     """
 
-    def __init__(self, root: Path, manifest: Manifest) -> None:
+    def __init__(
+        self, root: Path, manifest: Manifest, *, manifest_sha256: str | None = None
+    ) -> None:
         self._root = Path(root)
         self._manifest = manifest
+        self._manifest_sha256 = manifest_sha256
 
     @classmethod
     def open(cls, root: str | Path) -> Dataset:
-        """Read and validate ``root/dataset.json`` (format version check included).
+        """Read and validate ``root/dataset.json`` (format version check included), once:
+        the opened dataset holds the manifest and its sha256, so pass it on rather than the
+        path (a function given the object reads nothing again).
 
         Raises:
             DatasetError: no manifest (unfinished generation or not a dataset), an invalid
@@ -144,7 +150,9 @@ class Dataset:
         root = Path(root)
         if not root.is_dir():
             raise DatasetError(f"{root}: no such directory; expected an sgdata dataset root")
-        return cls(root, read_manifest(root))
+        raw = manifest_bytes(root)
+        manifest = parse_manifest(raw, root / MANIFEST)
+        return cls(root, manifest, manifest_sha256=hashlib.sha256(raw).hexdigest())
 
     def __repr__(self) -> str:
         m = self._manifest
@@ -162,6 +170,13 @@ class Dataset:
     def manifest(self) -> Manifest:
         """The validated ``dataset.json``."""
         return self._manifest
+
+    @property
+    def manifest_sha256(self) -> str:
+        """The sha256 of ``dataset.json`` as read at :meth:`open` (the data's fingerprint)."""
+        if self._manifest_sha256 is None:  # made from a Manifest, not opened: the file's
+            self._manifest_sha256 = sha256_file(self._root / MANIFEST)[0]
+        return self._manifest_sha256
 
     @property
     def splits(self) -> list[str]:
