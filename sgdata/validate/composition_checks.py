@@ -4,6 +4,7 @@ tier rules and the stored offsets; rooms never shared by two splits' observation
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -26,79 +27,110 @@ def _shares(raw: dict[str, Any]) -> list[float]:
     return list(shares) if shares else [t.share for t in TIERS]
 
 
-def check_triplets(tables: SplitTables, raw: dict[str, Any], out: Collector) -> None:
-    """Every triplet rule for one split."""
-    tri = tables.triplets
-    if tri is None:
-        return
-    file, split = tables.triplets_file, tables.split
-    n = tri.num_rows
+@dataclass(frozen=True)
+class _Triplets:
+    """One split's triplet table and where its problems go."""
 
-    def report(check: str, bad: np.ndarray, field: str, message: Any) -> None:
+    tables: SplitTables
+    out: Collector
+    table: pa.Table
+
+    @property
+    def n(self) -> int:
+        return self.table.num_rows
+
+    def report(self, check: str, bad: np.ndarray, field: str, message: Any) -> None:
+        """One problem per True of ``bad`` (a triplet row); ``message`` a string or callable."""
         for r in np.flatnonzero(bad):
             text = message(r) if callable(message) else message
-            out.add(check, file, text, row=int(r), field=field)
+            self.out.add(check, self.tables.triplets_file, text, row=int(r), field=field)
 
-    out.count("triplets.ids", n)
-    ids = column_numpy(tri, "triplet_id")
-    report(
+
+def check_triplets(tables: SplitTables, raw: dict[str, Any], out: Collector) -> None:
+    """Every triplet rule for one split."""
+    if tables.triplets is None:
+        return
+    tri = _Triplets(tables, out, tables.triplets)
+    room = _check_ids_and_rooms(tri, raw)
+    index, found = _check_references(tri)
+    if tables.observations is not None:
+        _check_one_room(tri, index, room)
+    tier = _check_tiers(tri, raw)
+    if tables.observations is not None:
+        _check_offsets(tri, index, found, tier)
+
+
+def _check_ids_and_rooms(tri: _Triplets, raw: dict[str, Any]) -> np.ndarray:
+    """Ids are row indices, the split is this one, rooms are the split's; returns the rooms."""
+    table, split, n = tri.table, tri.tables.split, tri.n
+    tri.out.count("triplets.ids", n)
+    ids = column_numpy(table, "triplet_id")
+    tri.report(
         "triplets.ids",
         ids != np.arange(n),
         "triplet_id",
         lambda r: f"{ids[r]}; expected the row index {r}",
     )
-    tsplit = column_numpy(tri, "split")
-    report(
+    tsplit = column_numpy(table, "split")
+    tri.report(
         "triplets.rooms",
         tsplit != split,
         "split",
         lambda r: f"{tsplit[r]!r} in the {split} table; triplets never cross splits",
     )
-    room = column_numpy(tri, "room_id")
+    room = column_numpy(table, "room_id")
     rooms = set(raw["splits"].get(split, []))
-    out.count("triplets.rooms", n)
-    report(
+    tri.out.count("triplets.rooms", n)
+    tri.report(
         "triplets.rooms",
         ~np.isin(room, list(rooms)),
         "room_id",
         lambda r: f"{room[r]!r} is not a room of split {split}",
     )
+    return room
 
-    # --- references: every anchor / positive / negative is a row of this split
-    obs = tables.observations
+
+def _check_references(tri: _Triplets) -> tuple[dict[str, np.ndarray], np.ndarray]:
+    """Every anchor / positive / negative is a row of this split; returns each role's row
+    index (-1: not found) and which triplets have all three."""
+    obs, split = tri.tables.observations, tri.tables.split
     obs_ids = obs.column("obs_id") if obs is not None else pa.array([], pa.string())
     index = {}
-    out.count("triplets.references", 3 * n)
+    tri.out.count("triplets.references", 3 * tri.n)
     for role in ROLES:
-        idx = pc.index_in(tri.column(role), value_set=obs_ids)
+        idx = pc.index_in(tri.table.column(role), value_set=obs_ids)
         index[role] = column_numpy(pa.table({"i": idx}), "i", -1).astype(np.int64)
-        values = column_numpy(tri, role)
-        report(
+        values = column_numpy(tri.table, role)
+        tri.report(
             "triplets.references",
             index[role] < 0,
             role,
             lambda r, v=values: f"{v[r]!r} is not an observation of split {split}",
         )
-    found = np.all([index[r] >= 0 for r in ROLES], axis=0)
+    return index, np.all([index[r] >= 0 for r in ROLES], axis=0)
 
-    # --- no triplet across rooms
-    if obs is not None:
-        obs_room = column_numpy(obs, "room_id")
-        for role in ROLES:
-            ok = index[role] >= 0
-            other = np.where(ok, obs_room[np.maximum(index[role], 0)], None)
-            bad = ok & (other != room)
-            report(
-                "triplets.rooms",
-                bad,
-                role,
-                lambda r, o=other: f"a view of room {o[r]!r} in a triplet of room {room[r]!r}",
-            )
 
-    # --- composition: tier shares
-    tier = column_numpy(tri, "tier").astype(np.int64)
+def _check_one_room(tri: _Triplets, index: dict[str, np.ndarray], room: np.ndarray) -> None:
+    """No triplet across rooms: its three views are of its room."""
+    obs_room = column_numpy(tri.tables.observations, "room_id")
+    for role in ROLES:
+        ok = index[role] >= 0
+        other = np.where(ok, obs_room[np.maximum(index[role], 0)], None)
+        tri.report(
+            "triplets.rooms",
+            ok & (other != room),
+            role,
+            lambda r, o=other: f"a view of room {o[r]!r} in a triplet of room {room[r]!r}",
+        )
+
+
+def _check_tiers(tri: _Triplets, raw: dict[str, Any]) -> np.ndarray:
+    """Tiers in range, their shares as configured (DESIGN §6) and as the manifest counts
+    them; returns the tiers."""
+    file, split, n, out = tri.tables.triplets_file, tri.tables.split, tri.n, tri.out
+    tier = column_numpy(tri.table, "tier").astype(np.int64)
     out.count("triplets.tiers", n)
-    report(
+    tri.report(
         "triplets.tiers",
         (tier < 0) | (tier >= len(TIERS)),
         "tier",
@@ -131,10 +163,14 @@ def check_triplets(tables: SplitTables, raw: dict[str, Any], out: Collector) -> 
             f"counts.tiers.{split} = {list(listed)} but {file} holds {counts.tolist()}",
             field=f"counts/tiers/{split}",
         )
+    return tier
 
-    # --- offsets from the grid poses: tier rules and the stored offsets
-    if obs is None:
-        return
+
+def _check_offsets(
+    tri: _Triplets, index: dict[str, np.ndarray], found: np.ndarray, tier: np.ndarray
+) -> None:
+    """Offsets recomputed from the views' grid poses: the stored ones, and the tier rules."""
+    obs = tri.tables.observations
     grid = {}
     posed = found.copy()
     for role in ROLES:
@@ -146,18 +182,17 @@ def check_triplets(tables: SplitTables, raw: dict[str, Any], out: Collector) -> 
             posed &= valid
             cols.append(column_numpy(obs, name, 0).astype(np.int64)[at])
         grid[role] = np.stack(cols, axis=1)
-    out.count("triplets.offsets", int(posed.sum()))
-    out.count("triplets.tier_rules", int(posed.sum()))
+    tri.out.count("triplets.offsets", int(posed.sum()))
+    tri.out.count("triplets.tier_rules", int(posed.sum()))
     a = grid["anchor"]
     for role in ("positive", "negative"):
         g = grid[role]
         step = (g[:, 3] - a[:, 3]) % 4
         offset = np.stack([g[:, 1] - a[:, 1], g[:, 2] - a[:, 2], np.where(step == 3, -1, step)], 1)
-        stored, _ = fixed_numpy(tri.column(f"{role}_offset").combine_chunks(), 3, np.int64)
-        bad = posed & np.any(stored != offset, axis=1)
-        report(
+        stored, _ = fixed_numpy(tri.table.column(f"{role}_offset").combine_chunks(), 3, np.int64)
+        tri.report(
             "triplets.offsets",
-            bad,
+            posed & np.any(stored != offset, axis=1),
             f"{role}_offset",
             lambda r, s=stored, o=offset: (
                 f"stored {s[r].tolist()}; the views' grid poses give {o[r].tolist()}"
@@ -171,7 +206,7 @@ def check_triplets(tables: SplitTables, raw: dict[str, Any], out: Collector) -> 
             wrong = sel & ((dist != rule.distance) | ((offset[:, 2] != 0) != rule.turn))
             if rule.other_layout:
                 wrong |= sel & same_layout
-            report(
+            tri.report(
                 "triplets.tier_rules",
                 wrong,
                 role,

@@ -3,10 +3,12 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from sgdata.dataset.paths import MANIFEST
 from sgdata.validate.loading import Flat, SplitTables, column_numpy, flatten_list
 from sgdata.validate.problems import Collector
 
@@ -67,7 +69,7 @@ def check_rows(tables: SplitTables, raw: dict[str, Any], out: Collector) -> None
     out.count("rows.camera", n)
     bad = synthetic & ((width != image["width"]) | (height != image["height"]))
     msg = lambda k: (  # noqa: E731
-        f"{width[k]}x{height[k]}; dataset.json image is {image['width']}x{image['height']}"
+        f"{width[k]}x{height[k]}; {MANIFEST} image is {image['width']}x{image['height']}"
     )
     _report(out, tables, "rows.camera", bad, rows, "camera", msg)
 
@@ -83,102 +85,122 @@ def _instance_codes(*arrays: np.ndarray) -> tuple[list[np.ndarray], int]:
     return out, int(inverse.max(initial=-1)) + 1
 
 
+@dataclass(frozen=True)
+class _Objects:
+    """The flattened objects of a split and where their problems go."""
+
+    tables: SplitTables
+    out: Collector
+    obj: Flat
+    synthetic: np.ndarray  # per object: its row is synthetic
+
+    @property
+    def rows(self) -> np.ndarray:
+        return self.obj.parent
+
+    def at(self, name: str) -> Any:
+        """The field of entry ``k`` as ``objects[i].name``."""
+        pos = self.obj.position
+        return lambda k: f"objects[{pos[k]}].{name}"
+
+    def report(self, check: str, bad: np.ndarray, field: str, message: Any) -> None:
+        _report(self.out, self.tables, check, bad, self.rows, self.at(field), message)
+
+
 def check_objects(tables: SplitTables, raw: dict[str, Any], out: Collector) -> Flat | None:
     """Object-level rules; returns the flattened objects for the relation checks."""
     obs = tables.observations
     if obs is None:
         return None
     obj = flatten_list(obs, "objects")
-    p, pos = obj.parent, obj.position
-    e = len(p)
-    loc = lambda name: lambda k: f"objects[{pos[k]}].{name}"  # noqa: E731
-    camera = obs.column("camera").combine_chunks()
-    width = column_numpy(camera, "width").astype(np.int64)[p]
-    height = column_numpy(camera, "height").astype(np.int64)[p]
-    synthetic = (column_numpy(obs, "domain") == "synthetic")[p]
+    synthetic = (column_numpy(obs, "domain") == "synthetic")[obj.parent]
+    objects = _Objects(tables, out, obj, synthetic)
+    _check_boxes2d(objects)
+    _check_boxes3d(objects)
+    class_name, safe_id, in_range = _check_classes(objects, raw["classes"])
+    _check_slots(objects, raw, safe_id, in_range)
+    _check_instances(objects, class_name)
+    return obj
 
+
+def _check_boxes2d(objects: _Objects) -> None:
+    """2D boxes inside the image, and visible pixels."""
+    obj, rows, e = objects.obj, objects.rows, len(objects.rows)
+    camera = objects.tables.observations.column("camera").combine_chunks()
+    width = column_numpy(camera, "width").astype(np.int64)[rows]
+    height = column_numpy(camera, "height").astype(np.int64)[rows]
     box, _ = obj.fixed("box2d", 4, np.int64)
     u1, v1, u2, v2 = box.T
     bad = ~((u1 >= 0) & (u1 < u2) & (u2 <= width) & (v1 >= 0) & (v1 < v2) & (v2 <= height))
-    out.count("objects.box2d", e)
-    _report(
-        out,
-        tables,
+    objects.out.count("objects.box2d", e)
+    objects.report(
         "objects.box2d",
         bad,
-        p,
-        loc("box2d"),
+        "box2d",
         lambda k: (
             f"{box[k].tolist()} in a {width[k]}x{height[k]} image; expected "
             "0 <= u1 < u2 <= width and 0 <= v1 < v2 <= height"
         ),
     )
     visible = obj.get("visible_pixels")
-    out.count("objects.visible_pixels", e)
-    _report(
-        out,
-        tables,
+    objects.out.count("objects.visible_pixels", e)
+    objects.report(
         "objects.visible_pixels",
         visible <= 0,
-        p,
-        loc("visible_pixels"),
+        "visible_pixels",
         lambda k: f"{visible[k]}; expected > 0",
     )
 
+
+def _check_boxes3d(objects: _Objects) -> None:
+    """3D boxes: set and ordered in synthetic rows, null in real ones."""
+    obj, synthetic = objects.obj, objects.synthetic
     lo, lo_ok = obj.fixed("box3d_min", 3, np.float64)
     hi, hi_ok = obj.fixed("box3d_max", 3, np.float64)
     obb_ok = obj.fixed("obb", 7, np.float64)[1]
-    out.count("objects.box3d", e)
+    objects.out.count("objects.box3d", len(objects.rows))
     inverted = lo_ok & hi_ok & np.any(lo > hi, axis=1)
-    _report(
-        out,
-        tables,
+    objects.report(
         "objects.box3d",
         synthetic & inverted,
-        p,
-        loc("box3d_min"),
+        "box3d_min",
         lambda k: f"min {lo[k].round(4).tolist()} > max {hi[k].round(4).tolist()} on some axis",
     )
     missing = synthetic & ~(lo_ok & hi_ok)
-    _report(
-        out, tables, "objects.box3d", missing, p, loc("box3d_min"), "null 3D box in a synthetic row"
-    )
+    objects.report("objects.box3d", missing, "box3d_min", "null 3D box in a synthetic row")
     real_box = ~synthetic & (lo_ok | hi_ok | obb_ok)
-    _report(
-        out,
-        tables,
+    objects.report(
         "objects.box3d",
         real_box,
-        p,
-        loc("box3d_min"),
+        "box3d_min",
         "3D box set in a real row; real photos have no 3D boxes (expected null)",
     )
 
-    classes = raw["classes"]
+
+def _check_classes(
+    objects: _Objects, classes: list[dict[str, Any]]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Class names in the vocabulary, ids that match them, known dynamics; returns the class
+    names, the ids made safe to index with, and which ids are in range."""
+    obj = objects.obj
     names = np.array([c["name"] for c in classes], dtype=object)
     class_id = obj.get("class_id").astype(np.int64)
     class_name = obj.get("class_name")
     in_range = (class_id >= 0) & (class_id < len(classes))
     safe_id = np.where(in_range, class_id, 0)
-    out.count("objects.class", e)
+    objects.out.count("objects.class", len(objects.rows))
     known = np.isin(class_name, names)
-    _report(
-        out,
-        tables,
+    objects.report(
         "objects.class",
         ~known,
-        p,
-        loc("class_name"),
-        lambda k: f"{class_name[k]!r} is not in the dataset.json class vocabulary",
+        "class_name",
+        lambda k: f"{class_name[k]!r} is not in the {MANIFEST} class vocabulary",
     )
     mismatch = known & (~in_range | (names[safe_id] != class_name))
-    _report(
-        out,
-        tables,
+    objects.report(
         "objects.class",
         mismatch,
-        p,
-        loc("class_id"),
+        "class_id",
         lambda k: (
             f"class_id {class_id[k]} is "
             + (f"{names[class_id[k]]!r}" if in_range[k] else "out of range")
@@ -186,99 +208,89 @@ def check_objects(tables: SplitTables, raw: dict[str, Any], out: Collector) -> F
         ),
     )
     dynamics = obj.get("dynamics")
-    _report(
-        out,
-        tables,
+    objects.report(
         "objects.class",
         ~np.isin(dynamics, DYNAMICS),
-        p,
-        loc("dynamics"),
+        "dynamics",
         lambda k: f"{dynamics[k]!r}; expected static, low or high",
     )
+    return class_name, safe_id, in_range
 
-    slot = obj.get("slot").astype(np.int64)
+
+def _check_slots(
+    objects: _Objects, raw: dict[str, Any], safe_id: np.ndarray, in_range: np.ndarray
+) -> None:
+    """Slots in range, inside their class's run, and one object per slot in a view."""
+    classes, rows = raw["classes"], objects.rows
+    names = np.array([c["name"] for c in classes], dtype=object)
+    slot = objects.obj.get("slot").astype(np.int64)
     num_slots = int(raw["num_slots"])
     starts = np.array([c["slot_start"] for c in classes], dtype=np.int64)[safe_id]
     counts = np.array([c["slot_count"] for c in classes], dtype=np.int64)[safe_id]
-    out.count("objects.slot", e)
+    objects.out.count("objects.slot", len(rows))
     outside = (slot < 0) | (slot >= num_slots)
-    _report(
-        out,
-        tables,
+    objects.report(
         "objects.slot",
         outside,
-        p,
-        loc("slot"),
+        "slot",
         lambda k: f"{slot[k]}; expected 0 <= slot < num_slots={num_slots}",
     )
     off_run = ~outside & in_range & ((slot < starts) | (slot >= starts + counts))
-    _report(
-        out,
-        tables,
+    objects.report(
         "objects.slot",
         off_run,
-        p,
-        loc("slot"),
+        "slot",
         lambda k: (
             f"{slot[k]} is outside the run of {names[safe_id[k]]!r} "
             f"[{starts[k]}, {starts[k] + counts[k]})"
         ),
     )
-    key = p * (num_slots + 1) + np.clip(slot, 0, num_slots)
+    key = rows * (num_slots + 1) + np.clip(slot, 0, num_slots)
     dup = _duplicates(key) & ~outside
-    _report(
-        out,
-        tables,
+    objects.report(
         "objects.slot",
         dup,
-        p,
-        loc("slot"),
+        "slot",
         lambda k: f"slot {slot[k]} is used by another object of the same view",
     )
 
-    instance = obj.get("instance").astype(np.int64)
-    out.count("objects.instance", e)
+
+def _check_instances(objects: _Objects, class_name: np.ndarray) -> None:
+    """Instances unique in a view, one class per instance in a room, no object on itself."""
+    obs, rows = objects.tables.observations, objects.rows
+    instance = objects.obj.get("instance").astype(np.int64)
+    objects.out.count("objects.instance", len(rows))
     (codes,), n_codes = _instance_codes(instance)
-    dup = _duplicates(p * max(n_codes, 1) + codes)
-    _report(
-        out,
-        tables,
+    dup = _duplicates(rows * max(n_codes, 1) + codes)
+    objects.report(
         "objects.instance",
         dup,
-        p,
-        loc("instance"),
+        "instance",
         lambda k: f"instance {instance[k]} appears twice in the view",
     )
     # An instance id is one object of the room: one class in every view of the room.
-    _, room_code = np.unique(column_numpy(obs, "room_id")[p], return_inverse=True)
+    _, room_code = np.unique(column_numpy(obs, "room_id")[rows], return_inverse=True)
     _, first, same = np.unique(
         room_code.astype(np.int64) * max(n_codes, 1) + codes, return_index=True, return_inverse=True
     )
     first_class = class_name[first][same]
     obs_ids = column_numpy(obs, "obs_id")
-    _report(
-        out,
-        tables,
+    objects.report(
         "objects.instance",
         class_name != first_class,
-        p,
-        loc("class_name"),
+        "class_name",
         lambda k: (
             f"instance {instance[k]} is {class_name[k]!r} here but {first_class[k]!r} in "
-            f"{obs_ids[p[first[same[k]]]]} of the same room; expected one class per instance"
+            f"{obs_ids[rows[first[same[k]]]]} of the same room; expected one class per instance"
         ),
     )
-    support = obj.get("support", -1).astype(np.int64)
-    _report(
-        out,
-        tables,
+    support = objects.obj.get("support", -1).astype(np.int64)
+    objects.report(
         "objects.instance",
         support == instance,
-        p,
-        loc("support"),
+        "support",
         lambda k: f"object {instance[k]} rests on itself",
     )
-    return obj
 
 
 def _duplicates(key: np.ndarray) -> np.ndarray:
@@ -313,7 +325,7 @@ def check_relations(tables: SplitTables, raw: dict[str, Any], obj: Flat, out: Co
         (kind < 0) | (kind >= len(names)),
         p,
         loc("type"),
-        lambda k: f"{kind[k]}; expected 0..{len(names) - 1} (dataset.json relation_types)",
+        lambda k: f"{kind[k]}; expected 0..{len(names) - 1} ({MANIFEST} relation_types)",
     )
 
     instance = obj.get("instance").astype(np.int64)
