@@ -15,6 +15,7 @@ overridden. :mod:`sgdata.usd.geometry` reads all of it back for the renderer.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -23,14 +24,18 @@ from pxr import Gf, Sdf, Usd, UsdGeom, UsdShade
 
 from sgdata.scene_files import textures_dir
 from sgdata.usd.materials import (
+    IMAGE_PREFIX,
     LOOKS,
     PART_PREFIX,
     bind_material,
     define_base_materials,
+    define_image_material,
     define_tinted_material,
+    image_material_path,
     set_parts,
     set_st,
     tinted_material_path,
+    write_image_file,
     write_texture_files,
 )
 from sgdata.usd.prims import (
@@ -47,6 +52,7 @@ from sgdata.usd.stage_frame import room_prim
 from sgdata.world.appearance import AppearanceConfig, LayoutAppearance, Look, room_looks, tinted
 from sgdata.world.materials import part_texture
 from sgdata.world.scene import Room, SceneObject
+from sgdata.world.shapes.base import PartTexture
 from sgdata.world.shapes.uvs import box_uvs
 
 __all__ = [
@@ -104,6 +110,8 @@ def read_room_parts(path: Path) -> RoomParts:
         body = str(body)
         colors = tuple(tuple(float(c) for c in v) for v in primvar.Get())
         sorted_parts = [part_texture(c, body) for c in colors]
+        for k in _image_parts(mesh, len(colors)):  # a mesh file's own texture: left alone
+            sorted_parts[k] = ("image", False)
         objects[int(instance)] = ObjectParts(
             prim.GetPath(),
             colors,  # type: ignore[arg-type]
@@ -112,6 +120,18 @@ def read_room_parts(path: Path) -> RoomParts:
         )
     root = room_prim(stage)
     return RoomParts(bool(looks), objects, materials, root.GetPath() if root else ROOT)
+
+
+def _image_parts(mesh: UsdGeom.Mesh, count: int) -> list[int]:
+    """The parts of ``mesh`` bound to a mesh file's image texture material."""
+    found = []
+    for k in range(count):
+        subset = mesh.GetPrim().GetChild(f"{PART_PREFIX}{k}")
+        rel = subset.GetRelationship(UsdShade.Tokens.materialBinding) if subset else None
+        targets = rel.GetTargets() if rel else []
+        if targets and targets[0].name.startswith(IMAGE_PREFIX):
+            found.append(k)
+    return found
 
 
 def override_light(layer: Sdf.Layer, parts: RoomParts, appearance: LayoutAppearance) -> None:
@@ -189,6 +209,12 @@ class RoomDresser:
         self.textures = textures if textures is not None else textures_dir(path.parent)
         self.looks = room_looks(room)
         self._materials: dict[Sdf.Path, tuple[str, int, tuple[float, float, float]]] = {}
+        self._images: dict[Sdf.Path, tuple[str, bytes, tuple[float, float, float]]] = {}
+
+    @property
+    def textured(self) -> bool:
+        """Whether the room is dressed in textured materials."""
+        return bool(self.appearance.textures)
 
     def structure(
         self,
@@ -213,8 +239,12 @@ class RoomDresser:
         vertices: np.ndarray,
         faces: np.ndarray,
         parts: np.ndarray,
+        images: tuple | None = None,
     ) -> None:
-        """Record an object's look; with textures, bind each of its parts (displayColor values)."""
+        """Record an object's look; with textures, bind each of its parts (displayColor values):
+        a part with a mesh file's image texture (``images``: each face's index into the
+        textures, corner st, the textures; see :class:`sgdata.usd.room_io.TexturedGeometry`)
+        to that image on the file's UVs, the others to their procedural texture."""
         look = self.looks.objects[obj.instance]
         prim.CreateAttribute(LOOK_TEXTURE, Sdf.ValueTypeNames.Token, custom=True).Set(look.texture)
         prim.CreateAttribute(LOOK_VARIANT, Sdf.ValueTypeNames.Int, custom=True).Set(look.variant)
@@ -224,12 +254,22 @@ class RoomDresser:
         if not self.appearance.textures:
             return
         colors = UsdGeom.PrimvarsAPI(mesh).GetPrimvar("displayColor").Get()
+        st = _rounded_uvs(vertices, faces)
+        image_of_part = np.full(len(colors), -1)
+        if images is not None:
+            face_image, uvs, textures = images
+            textured = np.asarray(face_image) >= 0
+            st[textured] = np.asarray(uvs, np.float32)[textured]
+            image_of_part[np.asarray(parts)[textured]] = np.asarray(face_image)[textured]
         materials = []
-        for value in colors:
+        for k, value in enumerate(colors):
             color = (float(value[0]), float(value[1]), float(value[2]))
+            if image_of_part[k] >= 0:
+                materials.append(self._image(textures[int(image_of_part[k])]))
+                continue
             kind, body = part_texture(color, look.texture)
             materials.append(self._material(kind, look.variant if body else 0, color))
-        set_st(mesh, _rounded_uvs(vertices, faces))
+        set_st(mesh, st)
         set_parts(mesh, parts, materials)
 
     def finish(self) -> None:
@@ -240,6 +280,16 @@ class RoomDresser:
         write_texture_files(self.textures, size)
         define_base_materials(self.stage, self.path, self.textures, size)
         define_layout_materials(self.stage.GetRootLayer(), self._materials)
+        relative = Path(os.path.relpath(self.textures, self.path.parent)).as_posix()
+        for path, (name, data, scale) in self._images.items():
+            write_image_file(self.textures, name, data)
+            define_image_material(self.stage, path, f"{relative}/{name}", scale)
+
+    def _image(self, texture: PartTexture) -> Sdf.Path:
+        scale = tuple(float(c) for c in texture.scale)
+        path = image_material_path(texture.name, scale)  # type: ignore[arg-type]
+        self._images.setdefault(path, (texture.name, texture.png, scale))  # type: ignore[arg-type]
+        return path
 
     def _material(self, kind: str, variant: int, color: tuple[float, ...]) -> Sdf.Path:
         rgb = (float(color[0]), float(color[1]), float(color[2]))

@@ -22,6 +22,18 @@ The on-disk contract of a textured ``room.usda`` (see also :mod:`sgdata.usd.room
 
 A face's colour is its texture times its tint, in linear RGB, exactly what
 ``primvars:displayColor`` holds for it (renderers without materials see the flat colours).
+
+A mesh file's own image textures (a glTF ``baseColorTexture``, an MTL ``map_Kd``) are copied
+into the same textures folder as ``mesh_<sha256[:16]>.png`` and bound to their faces' parts::
+
+    /Room/Looks/image_<sha256[:16]>_<colour>  Material; Surface (UsdPreviewSurface,
+                                              diffuseColor <- Texture.outputs:rgb), Texture
+                                              (UsdUVTexture, the file, sRGB, repeat, scale =
+                                              the file's base colour, st <- Reader), Reader
+                                              (UsdPrimvarReader_float2 "st", the file's UVs)
+
+Those faces' ``primvars:st`` are the file's UVs and their displayColor the texture's colour
+at each face's centre times the base colour (the flat fallback).
 Texture images are shared by every room of a folder: :func:`write_texture_files` writes the
 ones missing and leaves identical ones alone.
 """
@@ -44,22 +56,27 @@ from sgdata.usd.prims import LOOKS
 from sgdata.world.textures import TEXTURE_KINDS, texture_file_name, texture_image
 
 __all__ = [
+    "IMAGE_PREFIX",
     "PART_FAMILY",
     "PART_PREFIX",
     "base_material_path",
     "bind_material",
     "define_base_materials",
+    "define_image_material",
+    "image_material_path",
     "define_tinted_material",
     "set_parts",
     "set_st",
     "texture_png",
     "tinted_material_path",
+    "write_image_file",
     "write_texture_files",
 ]
 
 PART_FAMILY = "materialBind"  # UsdShade's family name for per-face material bindings
 PART_PREFIX = "part_"  # subset k of a mesh holds the faces of its k-th displayColor value
 _TINT = "tint"
+IMAGE_PREFIX = "image_"  # materials of a mesh file's own image textures
 
 
 @cache
@@ -97,6 +114,55 @@ def write_texture_files(directory: Path, size: int) -> list[Path]:
                 raise UsdError(f"{path}: cannot write texture ({exc.strerror or exc})") from None
             paths.append(path)
     return paths
+
+
+def write_image_file(directory: Path, name: str, data: bytes) -> Path:
+    """Write a mesh file's texture image (PNG bytes) as ``directory/name``, unless the same
+    bytes are there already.
+
+    Raises:
+        UsdError: the file cannot be written.
+    """
+    path = Path(directory) / name
+    try:
+        if not (path.is_file() and path.stat().st_size == len(data) and path.read_bytes() == data):
+            atomic_write_bytes(path, data)
+    except OSError as exc:
+        raise UsdError(f"{path}: cannot write texture ({exc.strerror or exc})") from None
+    return path
+
+
+def image_material_path(name: str, scale: tuple[float, float, float]) -> Sdf.Path:
+    """``/Room/Looks/image_<image>_<8 hex digits>``: image file ``name`` times ``scale``."""
+    digest = hashlib.blake2b(np.asarray(scale, np.float32).tobytes(), digest_size=4).hexdigest()
+    stem = Path(name).stem.removeprefix("mesh_")
+    return LOOKS.AppendChild(f"{IMAGE_PREFIX}{stem}_{digest}")
+
+
+def define_image_material(
+    stage: Usd.Stage, path: Sdf.Path, file: str, scale: tuple[float, float, float]
+) -> None:
+    """Define the material of a mesh file's image texture at ``path``: ``file`` (relative to
+    the room's folder) read on the mesh's ``st`` as is, times ``scale``."""
+    material = UsdShade.Material.Define(stage, path)
+    reader = _shader(stage, path, "Reader", "UsdPrimvarReader_float2")
+    reader.CreateInput("varname", Sdf.ValueTypeNames.String).Set("st")
+    st = reader.CreateOutput("result", Sdf.ValueTypeNames.Float2)
+    texture = _shader(stage, path, "Texture", "UsdUVTexture")
+    texture.CreateInput("file", Sdf.ValueTypeNames.Asset).Set(Sdf.AssetPath(file))
+    texture.CreateInput("sourceColorSpace", Sdf.ValueTypeNames.Token).Set("sRGB")
+    texture.CreateInput("wrapS", Sdf.ValueTypeNames.Token).Set("repeat")
+    texture.CreateInput("wrapT", Sdf.ValueTypeNames.Token).Set("repeat")
+    texture.CreateInput("st", Sdf.ValueTypeNames.Float2).ConnectToSource(st)
+    r, g, b = (float(np.float32(c)) for c in scale)
+    texture.CreateInput("scale", Sdf.ValueTypeNames.Float4).Set(Gf.Vec4f(r, g, b, 1.0))
+    rgb = texture.CreateOutput("rgb", Sdf.ValueTypeNames.Float3)
+    surface = _shader(stage, path, "Surface", "UsdPreviewSurface")
+    surface.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).ConnectToSource(rgb)
+    surface.CreateInput("roughness", Sdf.ValueTypeNames.Float).Set(0.5)
+    surface.CreateInput("metallic", Sdf.ValueTypeNames.Float).Set(0.0)
+    out = surface.CreateOutput("surface", Sdf.ValueTypeNames.Token)
+    material.CreateSurfaceOutput().ConnectToSource(out)
 
 
 def base_material_path(kind: str, variant: int) -> Sdf.Path:

@@ -30,7 +30,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
 import numpy as np
 from pxr import Gf, Kind, Sdf, Usd, UsdGeom, Vt
@@ -44,9 +44,12 @@ if TYPE_CHECKING:
     from sgdata.usd.looks import RoomDresser
     from sgdata.world.appearance import AppearanceConfig
     from sgdata.world.catalog import Catalog
+    from sgdata.world.shapes import PartTexture
 
 __all__ = [
     "Geometry",
+    "ObjectTextures",
+    "TexturedGeometry",
     "catalog_geometry",
     "write_room",
     "read_room",
@@ -78,23 +81,56 @@ _DOUBLE, _DOUBLE3 = Sdf.ValueTypeNames.Double, Sdf.ValueTypeNames.Double3
 _FLOAT3, _COLOR3F = Sdf.ValueTypeNames.Float3, Sdf.ValueTypeNames.Color3f
 
 
-def catalog_geometry(catalog: Catalog | None = None) -> Geometry:
+# (face -> index into textures or -1 (F,), corner st (F, 3, 2), textures) of one object's
+# faces: a mesh file's own image textures (sgdata.world.shapes.merged_textures)
+ObjectTextures = tuple[np.ndarray, np.ndarray, "tuple[PartTexture, ...]"]
+
+
+@runtime_checkable
+class TexturedGeometry(Protocol):
+    """A :data:`Geometry` that also gives the image textures of an object's faces (the mesh
+    files' own); a textured room binds them instead of the procedural textures."""
+
+    def __call__(self, obj: SceneObject) -> tuple[np.ndarray, np.ndarray, np.ndarray]: ...
+
+    def textures(self, obj: SceneObject) -> ObjectTextures | None: ...
+
+
+class _CatalogGeometry:
+    """Each object's catalog recipe (or mesh files), merged into one mesh; mesh files' image
+    textures on request."""
+
+    def __init__(self, catalog: Catalog) -> None:
+        self.catalog = catalog
+
+    def __call__(self, obj: SceneObject) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        from sgdata.world.mesh_assets import class_shape
+        from sgdata.world.shapes import merged_mesh
+
+        spec = self.catalog[obj.class_name]
+        return merged_mesh(class_shape(spec, obj.size, obj.variant, obj.color))
+
+    def textures(self, obj: SceneObject) -> ObjectTextures | None:
+        spec = self.catalog[obj.class_name]
+        if spec.mesh is None:  # recipes have no image textures
+            return None
+        from sgdata.world.mesh_assets import mesh_build
+        from sgdata.world.shapes import merged_textures
+
+        face, st, textures = merged_textures(mesh_build(spec, obj.size, obj.variant, obj.color))
+        return (face, st, textures) if textures else None
+
+
+def catalog_geometry(catalog: Catalog | None = None) -> TexturedGeometry:
     """The default geometry source: each object's catalog recipe (or mesh file), merged into
-    one mesh.
+    one mesh, with the mesh files' image textures (:class:`TexturedGeometry`).
 
     Args:
         catalog: the catalog naming each class's recipe; the shipped one when ``None``.
     """
     from sgdata.world.catalog import load_catalog  # late: the catalog and recipes pull in trimesh
-    from sgdata.world.mesh_assets import class_shape
-    from sgdata.world.shapes import merged_mesh
 
-    cat = catalog if catalog is not None else load_catalog()
-
-    def geometry(obj: SceneObject) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        return merged_mesh(class_shape(cat[obj.class_name], obj.size, obj.variant, obj.color))
-
-    return geometry
+    return _CatalogGeometry(catalog if catalog is not None else load_catalog())
 
 
 # ---------------------------------------------------------------------------------- writing
@@ -193,16 +229,33 @@ def _define_object(
         rel = prim.CreateRelationship(rel_name, custom=True)
         rel.SetTargets([object_path(by_instance[target])])
     vertices, faces, colors = _checked_mesh(where, *geometry(obj))
-    mesh, parts = _define_mesh(stage, object_path(obj).AppendChild("Geom"), vertices, faces, colors)
+    images = None
+    if dresser is not None and dresser.textured and isinstance(geometry, TexturedGeometry):
+        images = geometry.textures(obj)
+    mesh, parts = _define_mesh(
+        stage,
+        object_path(obj).AppendChild("Geom"),
+        vertices,
+        faces,
+        colors,
+        None if images is None else images[0],
+    )
     if dresser is not None:
-        dresser.object(prim, obj, mesh, vertices, faces, parts)
+        dresser.object(prim, obj, mesh, vertices, faces, parts, images)
 
 
 def _define_mesh(
-    stage: Usd.Stage, path: Sdf.Path, vertices: np.ndarray, faces: np.ndarray, colors: np.ndarray
+    stage: Usd.Stage,
+    path: Sdf.Path,
+    vertices: np.ndarray,
+    faces: np.ndarray,
+    colors: np.ndarray,
+    images: np.ndarray | None = None,
 ) -> tuple[UsdGeom.Mesh, np.ndarray]:
     """A triangle mesh with an indexed uniform displayColor; returns it and the part
-    (index of its colour among the distinct colours, in order of first use) of each face."""
+    (index of its colour among the distinct colours, in order of first use) of each face.
+    With ``images`` (each face's image texture, -1 none) a part is a distinct colour and image
+    (two parts may then share a displayColor value)."""
     mesh = UsdGeom.Mesh.Define(stage, path)
     points = Vt.Vec3fArray.FromNumpy(np.ascontiguousarray(vertices, dtype=np.float32))
     mesh.CreatePointsAttr(points)
@@ -213,7 +266,12 @@ def _define_mesh(
     mesh.CreateExtentAttr(UsdGeom.Mesh.ComputeExtent(points))
     mesh.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
     mesh.CreateDoubleSidedAttr(False)
-    values, parts = _parts(np.asarray(colors, dtype=np.float32).reshape(-1, 3))
+    flat = np.asarray(colors, dtype=np.float32).reshape(-1, 3)
+    if images is None:
+        values, parts = _parts(flat)
+    else:
+        keyed, parts = _parts(np.c_[flat, np.asarray(images, np.float32).reshape(-1, 1)])
+        values = np.ascontiguousarray(keyed[:, :3], dtype=np.float32)
     primvar = mesh.CreateDisplayColorPrimvar(UsdGeom.Tokens.uniform)
     primvar.Set(Vt.Vec3fArray.FromNumpy(values))
     primvar.SetIndices(Vt.IntArray.FromNumpy(parts))

@@ -1,7 +1,7 @@
 """Mesh files as catalog classes: read, check and measure each file once, and build its shape.
 
 A catalog class with ``mesh = "my_assets/mugs/*.glb"`` has one variant per file (glTF / GLB,
-OBJ with its MTL, PLY, STL; read with trimesh). Each file is checked (a known format, its
+OBJ with its MTL, PLY, STL read with trimesh; USD / USDZ by the reader the pipeline registers). Each file is checked (a known format, its
 textures present, vertices, faces with area, no NaN) and measured like a user's room: its up
 axis (Y or Z) and unit (m, cm, mm) are the ones that put its size within the class's size
 bounds (or those the class declares), its front turned to -Y, and it is moved to the local frame
@@ -9,8 +9,10 @@ of every object (footprint centred on the origin, resting on z = 0). The scale p
 (the default) keeps its true size, which must lie within the bounds; ``fit`` scales it
 uniformly into them. From the measured mesh come the floor footprint (the convex hull of its
 projection) and the support surfaces of its upward faces (a table top, shelf levels, a bowl's
-inside). Colours: a face's material base colour, times its texture sampled at the face's UV
-centroid, so textures reach the renderer as face colours.
+inside). Colours, UVs and texture images come from :mod:`sgdata.world.mesh_files`: a face's
+flat colour is its base colour times its texture at the face's UV centroid; a textured part
+also carries its image and UVs (:class:`~sgdata.world.shapes.PartTexture`), which a textured
+room binds in UsdShade (:mod:`sgdata.usd.looks`).
 
 Everything read is cached per process (one read per worker), keyed by the file's path, size and
 modification time; the bytes of a file, not its name, decide what a dataset holds (its sha256
@@ -20,9 +22,7 @@ goes to the manifest: :func:`asset_files`).
 from __future__ import annotations
 
 import hashlib
-import json
 import math
-import re
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
@@ -31,7 +31,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from sgdata.errors import CatalogError
-from sgdata.world.shapes.base import Part, ShapeBuild, Surface
+from sgdata.world.mesh_files import MeshImage, RawMesh, read_mesh_file, texture_files
+from sgdata.world.shapes.base import Part, PartTexture, ShapeBuild, Surface
 
 if TYPE_CHECKING:
     from sgdata.world.catalog import Catalog, ClassSpec, MeshSource
@@ -60,7 +61,6 @@ UP_NORMAL = 0.95  # a face is "upward" (part of a support surface) when its norm
 LEVEL_STEP = 0.005  # metres: upward faces within one step of height form one surface
 MIN_SURFACE_SHARE = 0.08  # of the footprint's box area: smaller levels offer no support
 SHRINK_STEPS = 8  # a surface's rectangle shrinks by 10 % at most this often to lie on its faces
-_NEUTRAL = np.array([0.7, 0.7, 0.7], np.float32)  # a face with no colour in its file
 
 
 @dataclass(frozen=True, eq=False)
@@ -80,6 +80,10 @@ class MeshAsset:
     surfaces: tuple[Surface, ...]  # support surfaces from upward faces
     textures: tuple[str, ...] = ()  # texture files it reads (absolute paths)
     texture_sha256: tuple[str, ...] = ()
+    face_base: np.ndarray | None = None  # (F, 3) float32 what a face's texture is multiplied by
+    face_uvs: np.ndarray | None = None  # (F, 3, 2) float32 corner texture coordinates
+    face_image: np.ndarray | None = None  # (F,) int32 index into images, -1 untextured
+    images: tuple[MeshImage, ...] = ()  # the texture images its faces use (PNG bytes)
 
     @property
     def triangles(self) -> int:
@@ -145,9 +149,13 @@ def _read_cached(
             f"{file}: unknown mesh format {suffix or '(no suffix)'!r}; expected one of "
             f"{', '.join(sorted(MESH_FORMATS))} (convert it, e.g. with Blender)"
         )
-    textures = _texture_files(file)
-    vertices, faces, colors = _read_mesh(file)
-    vertices, faces, colors = _checked(file, vertices, faces, colors)
+    textures = texture_files(file)
+    raw = read_mesh_file(file)
+    vertices, keep = _checked(file, raw.vertices, raw.faces)
+    faces = raw.faces[keep].astype(np.int32)
+    source = _declared(raw, source)
+    if raw.meters_per_unit is not None:  # the file says its unit: read it in metres
+        vertices = vertices * raw.meters_per_unit
     up, units, scale = _measure(file, vertices, source, size_min, size_max, class_name)
     local = _to_local(vertices, up, source.front) * _UNITS[units] * scale
     lo, hi = local.min(axis=0), local.max(axis=0)
@@ -158,7 +166,7 @@ def _read_cached(
         sha256=_sha256(file),
         vertices=local,
         faces=faces,
-        face_colors=colors,
+        face_colors=np.clip(raw.colors[keep], 0.0, 1.0),
         size=(size[0], size[1], size[2]),
         up=up,
         units=units,
@@ -166,114 +174,32 @@ def _read_cached(
         surfaces=_surfaces(local, faces),
         textures=tuple(str(t) for t in textures),
         texture_sha256=tuple(_sha256(t) for t in textures),
+        face_base=np.clip(raw.base[keep], 0.0, 1.0),
+        face_uvs=raw.uvs[keep],
+        face_image=raw.face_image[keep],
+        images=raw.images,
     )
+
+
+def _declared(raw: RawMesh, source: MeshSource) -> MeshSource:
+    """``source`` with the up axis and unit a file declares (USD's upAxis, metersPerUnit)
+    where the class entry leaves them to be measured."""
+    import dataclasses
+
+    changes = {}
+    if raw.up is not None and source.up == "auto":
+        changes["up"] = raw.up
+    if raw.meters_per_unit is not None and source.units == "auto":
+        changes["units"] = "m"
+    return dataclasses.replace(source, **changes) if changes else source
 
 
 # ------------------------------------------------------------------------------- reading
 
 
-def _texture_files(file: Path) -> list[Path]:
-    """The image files an OBJ's MTL or a .gltf names; a missing one is refused here (trimesh
-    would drop it silently and draw the mesh untextured)."""
-    names: list[tuple[Path, str]] = []
-    suffix = file.suffix.lower()
-    try:
-        if suffix == ".obj":
-            for line in file.read_text(encoding="utf-8", errors="replace").splitlines():
-                if line.startswith("mtllib "):
-                    mtl = file.parent / line[7:].strip()
-                    if not mtl.is_file():
-                        raise CatalogError(
-                            f"{file}: its material file {mtl.name!r} is missing (looked in "
-                            f"{mtl.parent}); put it beside the OBJ or remove the mtllib line"
-                        )
-                    for entry in mtl.read_text(encoding="utf-8", errors="replace").splitlines():
-                        match = re.match(r"\s*(map_Kd|map_Ka|map_d|map_Bump|bump)\s+(.+)", entry)
-                        if match:
-                            names.append((mtl, match.group(2).split()[-1]))
-        elif suffix == ".gltf":
-            doc = json.loads(file.read_text(encoding="utf-8"))
-            for image in doc.get("images", []):
-                uri = image.get("uri", "")
-                if uri and not uri.startswith("data:"):
-                    names.append((file, uri))
-    except (OSError, UnicodeDecodeError, ValueError) as exc:
-        raise CatalogError(f"{file}: cannot read the mesh file ({exc})") from None
-    found = []
-    for owner, name in names:
-        texture = owner.parent / name
-        if not texture.is_file():
-            raise CatalogError(
-                f"{file}: texture {name!r} (named in {owner.name}) is missing; put it in "
-                f"{texture.parent} or remove it from {owner.name}"
-            )
-        if texture.resolve() not in found:
-            found.append(texture.resolve())
-    return sorted(found)
-
-
-def _read_mesh(file: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Vertices, faces and face colours of every mesh in the file, in the file's frame and
-    units, the scene graph's transforms applied."""
-    import trimesh  # late: heavy, and only the reading side needs it
-
-    try:
-        loaded = trimesh.load(str(file), process=False)
-    except Exception as exc:  # noqa: BLE001 -- any reader failure is the file's fault
-        first = (str(exc).strip().splitlines() or [type(exc).__name__])[0][:160]
-        raise CatalogError(f"{file}: cannot read the mesh ({first})") from None
-    meshes = loaded.dump() if isinstance(loaded, trimesh.Scene) else [loaded]
-    meshes = [m for m in meshes if isinstance(m, trimesh.Trimesh) and len(m.faces)]
-    if not meshes:
-        raise CatalogError(f"{file}: the file holds no triangles (an empty mesh); re-export it")
-    vertices, faces, colors, offset = [], [], [], 0
-    for mesh in meshes:
-        v = np.asarray(mesh.vertices, np.float64)
-        vertices.append(v)
-        faces.append(np.asarray(mesh.faces, np.int64) + offset)
-        colors.append(_face_colors(mesh))
-        offset += len(v)
-    return np.concatenate(vertices), np.concatenate(faces), np.concatenate(colors)
-
-
-def _face_colors(mesh) -> np.ndarray:  # noqa: ANN001 -- a trimesh.Trimesh
-    """(F, 3) colours: vertex or face colours as stored; for a material, its base colour
-    times its texture at each face's UV centroid."""
-    count = len(mesh.faces)
-    visual = mesh.visual
-    kind = getattr(visual, "kind", None)
-    if kind in ("face", "vertex"):
-        return np.asarray(visual.face_colors, np.float32)[:, :3] / 255.0
-    if kind != "texture":
-        return np.tile(_NEUTRAL, (count, 1))
-    material = visual.material
-    factor = getattr(material, "baseColorFactor", None)
-    image = getattr(material, "baseColorTexture", None)
-    if factor is None and image is None:  # a SimpleMaterial (OBJ + MTL): the map, else Kd
-        image = getattr(material, "image", None)
-        factor = getattr(material, "diffuse", None) if image is None else None
-    base = (
-        np.asarray(factor, np.float32).reshape(-1)[:3] / 255.0
-        if factor is not None
-        else np.ones(3, np.float32)
-    )
-    colors = np.tile(base, (count, 1))
-    uv = getattr(visual, "uv", None)
-    if image is not None and uv is not None and len(uv) == len(mesh.vertices):
-        pixels = np.asarray(image.convert("RGB"), np.float32) / 255.0
-        h, w = pixels.shape[:2]
-        centre = np.asarray(uv, np.float64)[np.asarray(mesh.faces)].mean(axis=1)
-        centre = np.nan_to_num(centre) % 1.0
-        col = np.minimum((centre[:, 0] * w).astype(np.int64), w - 1)
-        row = np.minimum(((1.0 - centre[:, 1]) * h).astype(np.int64), h - 1)
-        colors = colors * pixels[row, col]
-    return colors.astype(np.float32)
-
-
-def _checked(
-    file: Path, vertices: np.ndarray, faces: np.ndarray, colors: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Refuse a mesh that cannot be placed; drop the few faces without area."""
+def _checked(file: Path, vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Refuse a mesh that cannot be placed; the vertices, and which faces to keep (the few
+    without area are dropped)."""
     if not np.isfinite(vertices).all():
         bad = int((~np.isfinite(vertices).all(axis=1)).sum())
         raise CatalogError(
@@ -290,8 +216,7 @@ def _checked(
             f"{file}: {int(flat.sum())} of {len(faces)} faces have no area (degenerate); "
             "repair the mesh (e.g. merge vertices, remove zero-area faces)"
         )
-    keep = ~flat
-    return vertices, faces[keep].astype(np.int32), np.clip(colors[keep], 0.0, 1.0)
+    return vertices, ~flat
 
 
 # ----------------------------------------------------------------------------- measuring
@@ -499,7 +424,11 @@ def mesh_build(
     factor = np.array(size, np.float64) / np.maximum(np.array(asset.size), 1e-9)
     vertices = asset.vertices * factor
     colors = asset.face_colors
-    keys, group = np.unique(np.round(colors * 63).astype(np.int64), axis=0, return_inverse=True)
+    image = asset.face_image if asset.face_image is not None else np.full(len(colors), -1)
+    base = asset.face_base if asset.face_base is not None else colors
+    # a part: the faces of one flat colour (and one texture image and base colour, if any)
+    key = np.c_[np.round(colors * 63), image, np.where(image[:, None] >= 0, np.round(base * 63), 0)]
+    keys, group = np.unique(key.astype(np.int64), axis=0, return_inverse=True)
     group = group.reshape(-1)
     main = -1
     if spec.mesh is not None and spec.mesh.recolor:
@@ -508,12 +437,19 @@ def mesh_build(
         main = int(np.argmax(np.bincount(group, weights=area, minlength=len(keys))))
     parts = []
     for k in range(len(keys)):
-        faces = asset.faces[group == k]
+        mine = group == k
+        faces = asset.faces[mine]
         used, local = np.unique(faces, return_inverse=True)
         mesh = trimesh.Trimesh(vertices[used], local.reshape(-1, 3), process=False)
-        mean = colors[group == k].mean(axis=0)
+        mean = colors[mine].mean(axis=0)
         part_color = color if k == main else (float(mean[0]), float(mean[1]), float(mean[2]))
-        parts.append(Part(mesh, part_color))
+        texture = None
+        if keys[k][3] >= 0 and asset.face_uvs is not None:
+            picture = asset.images[int(keys[k][3])]
+            tint = base[mine].mean(axis=0)
+            scale = color if k == main else (float(tint[0]), float(tint[1]), float(tint[2]))
+            texture = PartTexture(picture.name, picture.png, asset.face_uvs[mine], scale)
+        parts.append(Part(mesh, part_color, texture))
     sx, sy, sz = factor
     surfaces = [
         Surface(s.x0 * sx, s.y0 * sy, s.x1 * sx, s.y1 * sy, s.z * sz, s.clearance * sz, s.inside)

@@ -15,10 +15,12 @@ from sgdata.world.shapes.base import (
     RECIPES,
     Attachment,
     Part,
+    PartTexture,
     ShapeBuild,
     Surface,
     build_shape,
     merged_mesh,
+    merged_textures,
 )
 from sgdata.world.shapes.uvs import box_uvs
 
@@ -26,9 +28,11 @@ __all__ = [
     "RECIPES",
     "Attachment",
     "Part",
+    "PartTexture",
     "ShapeBuild",
     "Surface",
     "box_uvs",
     "build_shape",
     "merged_mesh",
+    "merged_textures",
 ]

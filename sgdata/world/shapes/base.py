@@ -18,6 +18,7 @@ __all__ = [
     "Attachment",
     "Color",
     "Part",
+    "PartTexture",
     "Recipe",
     "ShapeBuild",
     "Size",
@@ -30,6 +31,7 @@ __all__ = [
     "frustum",
     "hollow_box",
     "merged_mesh",
+    "merged_textures",
     "open_cylinder",
     "recipe",
     "rotated_box",
@@ -49,12 +51,24 @@ WHITE: Color = (0.92, 0.92, 0.9)
 GLASS: Color = (0.55, 0.72, 0.85)
 
 
+@dataclass(frozen=True, eq=False)
+class PartTexture:
+    """An image texture on a part's faces (a mesh file's own; recipes have none)."""
+
+    name: str  # file name in a scene's textures folder (by the PNG's sha256)
+    png: bytes  # the image, PNG-encoded
+    uvs: np.ndarray  # (F, 3, 2) float32 corner coordinates of the part's faces (bottom-left)
+    scale: Color  # the colour the image is multiplied by (the material's base colour)
+
+
 @dataclass(frozen=True)
 class Part:
-    """One closed primitive mesh of a shape, in the local frame, with its colour."""
+    """One closed primitive mesh of a shape, in the local frame, with its colour (and, from a
+    mesh file, its image texture: ``color`` is then what a renderer without textures draws)."""
 
     mesh: trimesh.Trimesh
     color: Color
+    texture: PartTexture | None = None
 
 
 @dataclass(frozen=True)
@@ -307,3 +321,22 @@ def merged_mesh(build: ShapeBuild) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         np.concatenate(faces).astype(np.int32),
         np.concatenate(colors),
     )
+
+
+def merged_textures(build: ShapeBuild) -> tuple[np.ndarray, np.ndarray, tuple[PartTexture, ...]]:
+    """The image textures of :func:`merged_mesh`'s faces: each face's index into the textured
+    parts' textures (-1 untextured, (F,) int32), the corner coordinates ((F, 3, 2) float32,
+    zero where untextured) and the textures in part order."""
+    which, uvs, textures = [], [], []
+    for part in build.parts:
+        n = len(part.mesh.faces)
+        if part.texture is None:
+            which.append(np.full(n, -1, np.int32))
+            uvs.append(np.zeros((n, 3, 2), np.float32))
+            continue
+        which.append(np.full(n, len(textures), np.int32))
+        uvs.append(np.asarray(part.texture.uvs, np.float32).reshape(n, 3, 2))
+        textures.append(part.texture)
+    if not which:
+        return np.zeros(0, np.int32), np.zeros((0, 3, 2), np.float32), ()
+    return np.concatenate(which), np.concatenate(uvs), tuple(textures)
