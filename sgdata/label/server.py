@@ -114,30 +114,107 @@ def create_app(
             bad class map.
     """
     store = LabelStore(out_dir)
-    names: ClassNames = load_class_names(store.class_map(class_map))
-    index = [scan_photos(photos_dir, max_pixels=max_pixels)]  # replaced by each rescan
-    scanning = threading.Lock()
-
+    names = load_class_names(store.class_map(class_map))
+    session = _Session(photos_dir, store, names, rules=rules, max_pixels=max_pixels)
     app = FastAPI(title="sgdata label", docs_url=None, redoc_url=None, openapi_url=None)
     if allowed_hosts is not None:
         app.add_middleware(_HostGuard, allowed=allowed_hosts)
+    _add_page_routes(app, session)
+    _add_api_routes(app, session)
+    return app
 
-    def photo_or_404(name: str) -> Photo:
-        photo = index[0].get(name)
+
+class _Session:
+    """What the app's routes share: the label store, the class names and the photo index."""
+
+    def __init__(
+        self,
+        photos_dir: Path,
+        store: LabelStore,
+        names: ClassNames,
+        *,
+        rules: ProposalRules,
+        max_pixels: int,
+    ) -> None:
+        self.photos_dir, self.store, self.names = photos_dir, store, names
+        self.rules, self.max_pixels = rules, max_pixels
+        self.index = scan_photos(photos_dir, max_pixels=max_pixels)  # replaced by each rescan
+        self._scanning = threading.Lock()
+
+    def photo(self, name: str) -> Photo:
+        """The indexed photo ``name``, or a 404."""
+        photo = self.index.get(name)
         if photo is None:
             raise HTTPException(404, "no such photo")
         return photo
 
-    def payload(name: str, labels: PhotoLabels) -> dict:
-        room = room_instances(store.labeled(), labels.room_id, name)
+    def payload(self, name: str, labels: PhotoLabels) -> dict:
+        """A photo's labels as the page edits them, with proposals and what is still missing."""
+        room = room_instances(self.store.labeled(), labels.room_id, name)
         return {
             "photo": name,
             "labels": labels.model_dump(mode="json"),
-            "proposals": [p.to_dict() for p in proposals_for(labels, names, rules)],
-            "problems": problems(labels, names, rules, room),
+            "proposals": [p.to_dict() for p in proposals_for(labels, self.names, self.rules)],
+            "problems": problems(labels, self.names, self.rules, room),
             # ids the room's other photos use: a new box takes a fresh one
             "room_ids": sorted(room),
         }
+
+    def listing(self) -> dict:
+        """Every photo (rescanned: photos copied in while the server runs appear) with its
+        labeling state, and the skipped files with the reason."""
+        with self._scanning:
+            self.index = scan_photos(
+                self.photos_dir, max_pixels=self.max_pixels, previous=self.index
+            )
+        saved = self.store.labeled()
+        rows = []
+        for name, p in self.index.photos.items():
+            labels = saved.get(name, PhotoLabels())
+            room = room_instances(saved, labels.room_id, name)
+            todo = problems(labels, self.names, self.rules, room)
+            rows.append(
+                {
+                    "name": name,
+                    "width": p.width,
+                    "height": p.height,
+                    "room_id": labels.room_id,
+                    "objects": len(labels.objects),
+                    "problems": todo,
+                    "ready": not todo,
+                }
+            )
+        skipped = [{"name": n, "reason": why} for n, why in self.index.skipped]
+        return {"photos": rows, "skipped": skipped}
+
+    def parse(self, found: Photo, body: bytes) -> PhotoLabels | JSONResponse:
+        """The labels of a PUT body, or the 400 / 422 answer naming what is wrong."""
+        try:
+            raw = json.loads(body)
+        except ValueError as exc:  # bad JSON, bad UTF-8, an integer of over 4,300 digits
+            raise HTTPException(400, f"malformed JSON ({str(exc)[:200]})") from None
+        except RecursionError:
+            raise HTTPException(400, "malformed JSON (nested too deeply)") from None
+        try:
+            labels = PhotoLabels.model_validate_json(json.dumps(raw))
+        except ValidationError as exc:
+            errors = [f"{'.'.join(map(str, e['loc']))}: {e['msg']}" for e in exc.errors()]
+            return JSONResponse({"detail": errors}, status_code=422)
+        w, h = found.width, found.height
+        outside = [o.id for o in labels.objects if o.box[2] > w or o.box[3] > h]
+        if outside:
+            detail = [f"objects {outside}: box outside the {found.width}x{found.height} photo"]
+            return JSONResponse({"detail": detail}, status_code=422)
+        known = set(self.names.all_names())
+        unknown = sorted({o.class_name for o in labels.objects if o.class_name} - known)
+        if unknown:
+            detail = [self.names.unknown(n) for n in unknown]
+            return JSONResponse({"detail": detail}, status_code=422)
+        return labels
+
+
+def _add_page_routes(app: FastAPI, session: _Session) -> None:
+    """The page, its static files and the photos themselves."""
 
     @app.get("/")
     def page() -> Response:
@@ -155,31 +232,17 @@ def create_app(
 
     @app.get("/photos/{name}")
     def photo(name: str) -> FileResponse:
-        found = photo_or_404(name)
+        found = session.photo(name)
         return FileResponse(found.path, media_type=f"image/{found.format}", headers=_HEADERS)
+
+
+def _add_api_routes(app: FastAPI, session: _Session) -> None:
+    """The JSON API the page talks to: photos, class names, a photo's labels."""
+    names = session.names
 
     @app.get("/api/photos")
     def photos() -> JSONResponse:
-        with scanning:  # photos copied in while the server runs appear on the next listing
-            index[0] = scan_photos(photos_dir, max_pixels=max_pixels, previous=index[0])
-        saved = store.labeled()
-        rows = []
-        for name, p in index[0].photos.items():
-            labels = saved.get(name, PhotoLabels())
-            todo = problems(labels, names, rules, room_instances(saved, labels.room_id, name))
-            rows.append(
-                {
-                    "name": name,
-                    "width": p.width,
-                    "height": p.height,
-                    "room_id": labels.room_id,
-                    "objects": len(labels.objects),
-                    "problems": todo,
-                    "ready": not todo,
-                }
-            )
-        skipped = [{"name": n, "reason": why} for n, why in index[0].skipped]
-        return JSONResponse({"photos": rows, "skipped": skipped}, headers=_HEADERS)
+        return JSONResponse(session.listing(), headers=_HEADERS)
 
     @app.get("/api/classes")
     def class_names() -> JSONResponse:
@@ -191,43 +254,22 @@ def create_app(
 
     @app.get("/api/labels/{name}")
     def get_labels(name: str) -> JSONResponse:
-        photo_or_404(name)
-        return JSONResponse(payload(name, store.load(name)), headers=_HEADERS)
+        session.photo(name)
+        return JSONResponse(session.payload(name, session.store.load(name)), headers=_HEADERS)
 
     @app.put("/api/labels/{name}")
     async def put_labels(name: str, request: Request) -> JSONResponse:
-        found = photo_or_404(name)
+        found = session.photo(name)
         if request.headers.get("content-type", "").split(";")[0].strip() != "application/json":
             raise HTTPException(415, "expected Content-Type: application/json")
-        body = await _read_body(request)
+        labels = session.parse(found, await _read_body(request))
+        if isinstance(labels, JSONResponse):
+            return labels
         try:
-            raw = json.loads(body)
-        except ValueError as exc:  # bad JSON, bad UTF-8, an integer of over 4,300 digits
-            raise HTTPException(400, f"malformed JSON ({str(exc)[:200]})") from None
-        except RecursionError:
-            raise HTTPException(400, "malformed JSON (nested too deeply)") from None
-        try:
-            labels = PhotoLabels.model_validate_json(json.dumps(raw))
-        except ValidationError as exc:
-            errors = [f"{'.'.join(map(str, e['loc']))}: {e['msg']}" for e in exc.errors()]
-            return JSONResponse({"detail": errors}, status_code=422)
-        w, h = found.width, found.height
-        outside = [o.id for o in labels.objects if o.box[2] > w or o.box[3] > h]
-        if outside:
-            detail = [f"objects {outside}: box outside the {found.width}x{found.height} photo"]
-            return JSONResponse({"detail": detail}, status_code=422)
-        unknown = sorted(
-            {o.class_name for o in labels.objects if o.class_name} - set(names.all_names())
-        )
-        if unknown:
-            return JSONResponse({"detail": [names.unknown(n) for n in unknown]}, status_code=422)
-        try:
-            stored = store.save(name, labels)
+            stored = session.store.save(name, labels)
         except ConflictError as exc:
             return JSONResponse({"detail": str(exc), "revision": exc.revision}, status_code=409)
-        return JSONResponse(payload(name, stored), headers=_HEADERS)
-
-    return app
+        return JSONResponse(session.payload(name, stored), headers=_HEADERS)
 
 
 def serve(
