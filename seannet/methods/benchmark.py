@@ -24,7 +24,7 @@ from __future__ import annotations
 import time
 from collections import defaultdict
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
@@ -67,7 +67,6 @@ class BenchmarkConfig:
     batch_size: int = 32  # views per embed() call
     map_layout: int = 0  # the layout the recall maps are built in
     noise: tuple[BoxNoise, ...] = NOISE_LEVELS  # the box-noise sweep (methods with uses_boxes)
-    extra: dict[str, Any] = field(default_factory=dict)  # recorded as given
 
     def __post_init__(self) -> None:
         if not self.seeds:

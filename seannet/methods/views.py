@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -133,10 +133,10 @@ class SplitData:
     triplets: np.ndarray  # (T, 3) int64: anchor, positive, negative view indices
     tiers: np.ndarray  # (T,) int64
     count: int  # views in the split
-    _views: object  # a callable (batch_size) -> Iterator[SceneBatch]
+    _views: Callable[[int], Iterator[SceneBatch]]  # batch_size -> the split's batches
     method: str = "?"
 
     def views(self, batch_size: int = 32) -> Iterator[Views]:
         """The split's views in order, ``batch_size`` at a time."""
-        for batch in self._views(batch_size):  # type: ignore[operator]
+        for batch in self._views(batch_size):
             yield Views(batch, method=self.method)
