@@ -12,7 +12,7 @@ from sgdata.pipeline.config import AnnotationConfig
 from sgdata.render.camera import CameraConfig
 from sgdata.render.renderer import Renderer
 from sgdata.usd.geometry import read_geometry
-from sgdata.usd.scene_dirs import layout_path, load_layout
+from sgdata.usd.scene_dirs import layout_stage_file, load_layout
 from sgdata.world.catalog import Catalog, load_catalog
 from sgdata.world.poses import HEADINGS_DEG, PosesConfig
 
@@ -72,5 +72,5 @@ def render_snapshot(
             keep_depth=True,  # read in the RGB pass: the channel strip costs no extra render
             keep_instances=True,
         )
-        annotator.set_layout(room, read_geometry(layout_path(room_dir, layout)), layout)
+        annotator.set_layout(room, read_geometry(layout_stage_file(room_dir, layout)), layout)
         return annotator.view(ViewPose(x, y, theta, i, j, heading))

@@ -55,7 +55,7 @@ _EXPORTS = {
     "read_room": ".room_io",
     "write_room": ".room_io",
     "layout_indices": ".scene_dirs",
-    "layout_path": ".scene_dirs",
+    "layout_stage_file": ".scene_dirs",
     "load_base": ".scene_dirs",
     "load_layout": ".scene_dirs",
     "write_layouts": ".scene_dirs",
@@ -82,7 +82,7 @@ _EXPORTS = {
 }
 
 # old names, still served (with a DeprecationWarning from their module) for one release
-_DEPRECATED = {"write_text_atomic": ".stage"}
+_DEPRECATED = {"write_text_atomic": ".stage", "layout_path": ".scene_dirs"}
 
 __all__ = sorted(_EXPORTS)
 __getattr__, __dir__ = lazy_face(__name__, {**_EXPORTS, **_DEPRECATED})

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from sgdata.deprecation import moved_names
 from sgdata.errors import ConfigError, SceneError
 from sgdata.fileio import prepare_output_dir
 from sgdata.scene_files import LAYOUT_FILE, ROOM_FILE, layout_file, room_file
@@ -26,7 +27,7 @@ __all__ = [
     "load_base",
     "load_layout",
     "layout_indices",
-    "layout_path",
+    "layout_stage_file",
 ]
 
 
@@ -134,8 +135,9 @@ def layout_indices(room_dir: Path) -> list[int]:
     return sorted(found)
 
 
-def layout_path(room_dir: Path, index: int) -> Path:
-    """The file of layout ``index``: ``layout_<k>.usda``; for 0 without one, ``room.usda``.
+def layout_stage_file(room_dir: Path, index: int) -> Path:
+    """The file to read layout ``index`` from: its layer ``layout_<k>.usda``
+    (:func:`sgdata.scene_files.layout_file`); for 0 without one, ``room.usda``.
 
     Layout 0 is the base arrangement, so a room tagged by ``sgdata tag`` renders before any
     ``sgdata layouts`` run.
@@ -155,7 +157,7 @@ def load_layout(room_dir: Path, index: int, catalog: Catalog | None = None) -> R
             object inside a wall).
     """
     load_base(room_dir)
-    path = layout_path(room_dir, index)
+    path = layout_stage_file(room_dir, index)
     if not path.is_file():
         have = layout_indices(room_dir)
         raise ConfigError(
@@ -167,3 +169,7 @@ def load_layout(room_dir: Path, index: int, catalog: Catalog | None = None) -> R
     if problems:
         raise SceneError(f"{path}: invalid layout: {problems[0]}")
     return room
+
+
+# old names, served with a DeprecationWarning for one release
+__getattr__ = moved_names(__name__, {"layout_path": "sgdata.usd.scene_dirs:layout_stage_file"})

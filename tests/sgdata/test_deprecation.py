@@ -18,6 +18,7 @@ MOVED = [
     ("sgdata.usd.stage", "write_text_atomic", "sgdata.usd.stage", "write_usd_file"),
     ("sgdata.dataset.manifest", "write_manifest", "sgdata.dataset.publish", "write_manifest"),
     ("sgdata.seeds", "init_seed", "seannet.seeds", "init_seed"),
+    ("sgdata.usd.scene_dirs", "layout_path", "sgdata.usd.scene_dirs", "layout_stage_file"),
     ("sgdata.seeds", "episode_seed", "seannet.seeds", "episode_seed"),
 ]
 
