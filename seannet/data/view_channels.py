@@ -62,16 +62,10 @@ def check_loader_channels(ds: Any, channels: Iterable[str], *, root: str | Path)
     for name in names:
         column = _SOURCE[name]
         if column not in stored:
-            from sgdata.label.detector_files import is_real  # only when refusing
-
-            why = (
-                "a real (labelled) dataset has no depth or masks"
-                if is_real(ds)
-                else f"generate it with [outputs] {column} = true"
-            )
             raise DataError(
-                f"dataset {root} ({ds.manifest.name}) has no {name} channel: {why}, "
-                "or ask for no channels"
+                f"dataset {root} ({ds.manifest.name}) has no {name} channel (a real labelled "
+                f"dataset has none; generate one with [outputs] {column} = true), or ask for "
+                "no channels"
             )
     return names
 
