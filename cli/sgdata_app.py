@@ -43,11 +43,13 @@ def rooms(
     ] = True,
 ) -> None:
     """Generate procedural rooms and write them as USD stages."""
+    from sgdata.usd.mesh_files import register_usd_mesh_reader
     from sgdata.usd.scene_dirs import write_rooms
     from sgdata.world.appearance import AppearanceConfig
     from sgdata.world.catalog import load_catalog
     from sgdata.world.rooms import room_stats
 
+    register_usd_mesh_reader()  # a catalog's mesh classes may name USD / USDZ files
     classes = load_catalog(catalog)
     made = write_rooms(
         out,
@@ -615,7 +617,10 @@ def assets_add(
     ] = None,
 ) -> None:
     """Write a catalog class for a folder of mesh files and print what was measured."""
+    from sgdata.usd.mesh_files import register_usd_mesh_reader
     from sgdata.world.asset_entries import add_asset_class
+
+    register_usd_mesh_reader()  # USD / USDZ files too
 
     added = add_asset_class(
         folder,

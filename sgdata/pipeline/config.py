@@ -213,7 +213,12 @@ class CatalogConfig:
         return tuple(Path(self.base_dir or ".") / Path(p).expanduser() for p in self.files)
 
     def load(self) -> Catalog:
-        """The catalog of a run: the shipped one with :meth:`paths` merged in (cached)."""
+        """The catalog of a run: the shipped one with :meth:`paths` merged in (cached); its
+        mesh classes may name USD / USDZ files too."""
+        if self.files:
+            from sgdata.usd.mesh_files import register_usd_mesh_reader  # late: pxr
+
+            register_usd_mesh_reader()
         return load_catalog(extra=self.paths())
 
 

@@ -30,7 +30,7 @@ from sgdata.usd.stage_frame import room_prim, stage_frame
 from sgdata.world.appearance import light_color
 from sgdata.world.scene import transform_points
 
-__all__ = ["DEFAULT_COLOR", "read_geometry", "stage_geometry"]
+__all__ = ["DEFAULT_COLOR", "prim_triangles", "read_geometry", "stage_geometry"]
 
 DEFAULT_COLOR = (0.6, 0.6, 0.6)  # face colour of meshes without a displayColor
 
@@ -140,6 +140,16 @@ def _lighting(stage: Usd.Stage) -> Lighting:
         temperature=None if kelvin is None else float(kelvin),
         color=(1.0, 1.0, 1.0) if kelvin is None else light_color(float(kelvin)),
     )
+
+
+def prim_triangles(prim: Usd.Prim, materials: MaterialReader) -> MeshData | None:
+    """The triangles of a mesh or a tessellated gprim in its own frame, with their colours and
+    bound textures; ``None`` for other prims.
+
+    Raises:
+        UsdError: a malformed mesh or gprim, or a bound texture that does not resolve.
+    """
+    return _prim_triangles(prim, materials)
 
 
 def _prim_triangles(prim: Usd.Prim, materials: MaterialReader) -> MeshData | None:

@@ -1,18 +1,19 @@
 """Mesh files as catalog classes: read, check and measure each file once, and build its shape.
 
 A catalog class with ``mesh = "my_assets/mugs/*.glb"`` has one variant per file (glTF / GLB,
-OBJ with its MTL, PLY, STL read with trimesh; USD / USDZ by the reader the pipeline registers). Each file is checked (a known format, its
-textures present, vertices, faces with area, no NaN) and measured like a user's room: its up
-axis (Y or Z) and unit (m, cm, mm) are the ones that put its size within the class's size
-bounds (or those the class declares), its front turned to -Y, and it is moved to the local frame
-of every object (footprint centred on the origin, resting on z = 0). The scale policy ``keep``
-(the default) keeps its true size, which must lie within the bounds; ``fit`` scales it
-uniformly into them. From the measured mesh come the floor footprint (the convex hull of its
-projection) and the support surfaces of its upward faces (a table top, shelf levels, a bowl's
-inside). Colours, UVs and texture images come from :mod:`sgdata.world.mesh_files`: a face's
-flat colour is its base colour times its texture at the face's UV centroid; a textured part
-also carries its image and UVs (:class:`~sgdata.world.shapes.PartTexture`), which a textured
-room binds in UsdShade (:mod:`sgdata.usd.looks`).
+OBJ with its MTL, PLY, STL read with trimesh; USD / USDZ by the reader the pipeline registers).
+Each file is checked (a known format, its textures present, vertices, faces with area, no NaN)
+and measured like a user's room: its up axis (Y or Z) and unit (m, cm, mm) are the ones that
+put its size within the class's size bounds (or those the class declares), its front turned to
+-Y, and it is moved to the local frame of every object (footprint centred on the origin,
+resting on z = 0). The scale policy ``keep`` (the default) keeps its true size, which must lie
+within the bounds; ``fit`` scales it uniformly into them. From the measured mesh come the floor
+footprint (the convex hull of its projection) and the support surfaces of its upward faces (a
+table top, shelf levels, a bowl's inside). Colours, UVs and texture images come from
+:mod:`sgdata.world.mesh_files`: a face's flat colour is its base colour times its texture at
+the face's UV centroid; a textured part also carries its image and UVs
+(:class:`~sgdata.world.shapes.PartTexture`), which a textured room binds in UsdShade
+(:mod:`sgdata.usd.looks`).
 
 Everything read is cached per process (one read per worker), keyed by the file's path, size and
 modification time; the bytes of a file, not its name, decide what a dataset holds (its sha256
@@ -31,7 +32,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from sgdata.errors import CatalogError
-from sgdata.world.mesh_files import MeshImage, RawMesh, read_mesh_file, texture_files
+from sgdata.world.mesh_files import (
+    MeshImage,
+    RawMesh,
+    mesh_reader,
+    read_mesh_file,
+    texture_files,
+)
 from sgdata.world.shapes.base import Part, PartTexture, ShapeBuild, Surface
 
 if TYPE_CHECKING:
@@ -51,6 +58,8 @@ __all__ = [
 
 # Readable formats and the up axis each usually has (glTF says Y; OBJ exporters mostly Y).
 MESH_FORMATS = {".glb": "y", ".gltf": "y", ".obj": "y", ".ply": "z", ".stl": "z"}
+# USD / USDZ: read by the reader sgdata.usd.mesh_files registers (an authored upAxis rules)
+MESH_FORMATS.update(dict.fromkeys((".usd", ".usda", ".usdc", ".usdz"), "y"))
 _UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001}
 # a measured size this far (as a factor) outside the class's bounds is refused under `keep`
 SIZE_TOLERANCE = 1.25
@@ -148,6 +157,11 @@ def _read_cached(
         raise CatalogError(
             f"{file}: unknown mesh format {suffix or '(no suffix)'!r}; expected one of "
             f"{', '.join(sorted(MESH_FORMATS))} (convert it, e.g. with Blender)"
+        )
+    if suffix in (".usd", ".usda", ".usdc", ".usdz") and mesh_reader(suffix) is None:
+        raise CatalogError(
+            f"{file}: USD mesh files are read by sgdata.usd.mesh_files; call "
+            "register_usd_mesh_reader() first (sgdata generate and the CLI do)"
         )
     textures = texture_files(file)
     raw = read_mesh_file(file)
