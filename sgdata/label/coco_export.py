@@ -139,8 +139,9 @@ def export_coco(
 
 def _require_masks(ds: Any, dataset_dir: Path) -> None:
     """Refuse ``--masks`` on a dataset that stores no instance masks."""
-    outputs = (ds.manifest.config or {}).get("outputs") or {}
-    if not outputs.get("instances"):
+    from sgdata.dataset.channels import stored_channels
+
+    if "instances" not in stored_channels(ds.manifest.config):
         real = "a real (labelled) dataset has none; " if is_real(ds) else ""
         raise ConfigError(
             f"--masks: {dataset_dir} has no instance masks ({real}generate it with "

@@ -182,11 +182,10 @@ def channel_sheet(ds: Dataset, *, views: int = 3) -> Image.Image | None:
     """The first ``views`` views of the first split that stores channels, each as its strip
     RGB | depth | instances | classes (:func:`sgdata.pictures.channels.channel_strip`); None
     when the dataset stores no channel."""
-    from sgdata.dataset.channels import decode_channel, depth_metres
+    from sgdata.dataset.channels import decode_channel, depth_metres, stored_channels
     from sgdata.pictures.channels import channel_strip
 
-    outputs = (ds.manifest.config or {}).get("outputs") or {}
-    if not (outputs.get("depth") or outputs.get("instances")):
+    if not stored_channels(ds.manifest.config):
         return None
     columns = ["image", "depth", "instances", "objects"]
     rows = ds.observations(ds.splits[0], columns=columns).slice(0, views).to_pylist()

@@ -21,7 +21,12 @@ import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from sgdata.dataset.channels import CHANNELS, DEPTH_UNITS_PER_METRE, decode_channel
+from sgdata.dataset.channels import (
+    CHANNELS,
+    DEPTH_UNITS_PER_METRE,
+    decode_channel,
+    stored_channels,
+)
 from sgdata.dataset.schema import observations_schema
 from sgdata.dataset.storage import memory_column
 from sgdata.errors import SgdataError
@@ -129,8 +134,7 @@ def _extent_problems(mask: np.ndarray, boxes: np.ndarray) -> list[str]:
 
 def check_channels(root: Path, raw: dict[str, Any], files: list[str], out: Collector) -> None:
     """Decode the channels of the given observation shards and check them against the rows."""
-    outputs = (raw.get("config") or {}).get("outputs") or {}
-    wanted = [c for c in CHANNELS if outputs.get(c)]
+    wanted = stored_channels(raw.get("config"))
     expected = observations_schema()
     diagonals: dict[str, float | None] = {}
     for rel in files:
