@@ -15,6 +15,7 @@ from sgdata.fileio import read_toml
 from sgdata.world.scene import Dynamics
 
 __all__ = [
+    "DEFAULT_MAX_TRIANGLES",
     "PLACEMENTS",
     "SIDES",
     "WALL",
@@ -60,6 +61,7 @@ _FIELDS = {
     "up",
     "units",
     "front",
+    "max_triangles",
 }
 
 # The recipe name a mesh class reports as its ``shape`` (no recipe of that name exists).
@@ -68,6 +70,9 @@ MESH_SCALES = ("keep", "fit")  # keep the file's true size (within bounds) | sca
 MESH_UPS = ("auto", "y", "z")  # the file's up axis; auto: measured against the size bounds
 MESH_UNITS = ("auto", "m", "cm", "mm")  # the file's unit; auto: measured likewise
 MESH_FRONTS = ("-y", "+y", "-x", "+x")  # the file's front axis, once its up axis is +Z
+# triangles a mesh class draws per variant at most (sgdata.world.mesh_detail; 0: all): a
+# 224-pixel view shows no more, and a CPU rasteriser pays for every triangle (bench/assets.py)
+DEFAULT_MAX_TRIANGLES = 2_000
 
 
 @dataclass(frozen=True)
@@ -81,6 +86,7 @@ class MeshSource:
     units: str = "auto"  # one of MESH_UNITS
     front: str = "-y"  # one of MESH_FRONTS
     recolor: bool = False  # a palette was given: its colours replace the main material's
+    max_triangles: int = DEFAULT_MAX_TRIANGLES  # drawn per variant at most; 0: every triangle
 
 
 @dataclass(frozen=True)
@@ -296,7 +302,7 @@ def _parse_class(path: Path, name: str, entry: Any) -> ClassSpec:
     )
 
 
-_MESH_ONLY = {"scale", "up", "units", "front"}
+_MESH_ONLY = {"scale", "up", "units", "front", "max_triangles"}
 _NEUTRAL = "#b3b3b3"  # the palette of a mesh class that keeps its files' colours (unused)
 
 
@@ -333,6 +339,14 @@ def _mesh_source(path: Path, where: str, entry: dict[str, Any]) -> MeshSource:
                     f"{where}: field {key!r} is {entry[key]!r}; expected one of {allowed}"
                 )
             options[key] = entry[key]
+    if "max_triangles" in entry:
+        limit = entry["max_triangles"]
+        if isinstance(limit, bool) or not isinstance(limit, int) or limit < 0:
+            raise CatalogError(
+                f"{where}: field 'max_triangles' is {limit!r}; expected a whole number >= 0 "
+                "(0 draws every triangle)"
+            )
+        options["max_triangles"] = limit
     return MeshSource(
         files=tuple(files),
         pattern=value if isinstance(value, str) else ", ".join(patterns),

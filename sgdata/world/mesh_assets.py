@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from sgdata.errors import CatalogError
+from sgdata.world.mesh_detail import budgets, decimate
 from sgdata.world.mesh_files import (
     MeshImage,
     RawMesh,
@@ -431,7 +432,8 @@ def mesh_build(
 ) -> ShapeBuild:
     """The parts (one per colour of the file) and support surfaces of variant ``variant`` of
     a mesh class, scaled to ``size``; a recolouring class (one with a palette) paints its
-    largest colour ``color``."""
+    largest colour ``color``. Parts are simplified to the class's ``max_triangles``
+    (:mod:`sgdata.world.mesh_detail`); the surfaces are the full mesh's."""
     import trimesh  # late: the recipes' part type
 
     asset = class_assets(spec)[variant % len(spec.mesh.files)]  # type: ignore[union-attr]
@@ -449,20 +451,26 @@ def mesh_build(
         tri = vertices[asset.faces]
         area = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
         main = int(np.argmax(np.bincount(group, weights=area, minlength=len(keys))))
+    limit = spec.mesh.max_triangles if spec.mesh is not None else 0
+    budget = budgets([int(n) for n in np.bincount(group, minlength=len(keys))], limit)
     parts = []
     for k in range(len(keys)):
         mine = group == k
         faces = asset.faces[mine]
         used, local = np.unique(faces, return_inverse=True)
-        mesh = trimesh.Trimesh(vertices[used], local.reshape(-1, 3), process=False)
+        uvs = asset.face_uvs[mine] if keys[k][3] >= 0 and asset.face_uvs is not None else None
+        part_vertices, part_faces, uvs = decimate(
+            vertices[used], local.reshape(-1, 3), budget[k], uvs
+        )
+        mesh = trimesh.Trimesh(part_vertices, part_faces, process=False)
         mean = colors[mine].mean(axis=0)
         part_color = color if k == main else (float(mean[0]), float(mean[1]), float(mean[2]))
         texture = None
-        if keys[k][3] >= 0 and asset.face_uvs is not None:
+        if uvs is not None:
             picture = asset.images[int(keys[k][3])]
             tint = base[mine].mean(axis=0)
             scale = color if k == main else (float(tint[0]), float(tint[1]), float(tint[2]))
-            texture = PartTexture(picture.name, picture.png, asset.face_uvs[mine], scale)
+            texture = PartTexture(picture.name, picture.png, uvs, scale)
         parts.append(Part(mesh, part_color, texture))
     sx, sy, sz = factor
     surfaces = [
