@@ -20,10 +20,13 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from sgdata.dataset.paths import MANIFEST
 from sgdata.fileio import sha256_file
+
+if TYPE_CHECKING:
+    from sgdata.dataset import Dataset
 
 __all__ = [
     "PROCESS",
@@ -80,10 +83,11 @@ PROCESS = ProcessState.capture()  # read once, when this process loaded seannet
 
 
 def provenance_record(
-    data: Path | None, *, step: str | None = None, process: ProcessState = PROCESS
+    data: Path | Dataset | None, *, step: str | None = None, process: ProcessState = PROCESS
 ) -> dict[str, Any]:
     """One record: ``process``'s code and command, the time, and ``data``'s fingerprint
-    (its manifest's sha256, format and version, dataset seed) when given."""
+    (its manifest's sha256, format and version, dataset seed) when given: a dataset opened
+    already (nothing is read again) or its root (its ``dataset.json`` read here)."""
     record: dict[str, Any] = {
         "step": step,
         "commit": process.commit,
@@ -93,21 +97,28 @@ def provenance_record(
         "command": process.command,
         "pid": os.getpid(),
     }
-    if data is not None:
-        manifest = json.loads((data / MANIFEST).read_text())
-        record |= {
-            "data": str(data),
-            "manifest_sha256": sha256_file(data / MANIFEST)[0],
-            "format": manifest.get("format"),
-            "format_version": manifest.get("format_version"),
-            "dataset_seed": manifest.get("config", {}).get("dataset", {}).get("seed"),
-        }
+    if data is None:
+        return record
+    from sgdata.dataset import Dataset  # here: importing seannet reads no Arrow
+
+    if isinstance(data, Dataset):  # opened already: its manifest and sha256, not read again
+        manifest, digest = data.manifest.to_dict(), data.manifest_sha256
+    else:
+        manifest = json.loads((Path(data) / MANIFEST).read_text())
+        digest = sha256_file(Path(data) / MANIFEST)[0]
+    record |= {
+        "data": str(data.root if isinstance(data, Dataset) else data),
+        "manifest_sha256": digest,
+        "format": manifest.get("format"),
+        "format_version": manifest.get("format_version"),
+        "dataset_seed": manifest.get("config", {}).get("dataset", {}).get("seed"),
+    }
     return record
 
 
 def append_provenance(
     directory: Path,
-    data: Path | None,
+    data: Path | Dataset | None,
     *,
     step: str | None = None,
     process: ProcessState = PROCESS,

@@ -8,11 +8,10 @@ camera did not). Reads only the dataset (3D boxes), no renderer.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from pathlib import Path
 
 import numpy as np
 
-from sgdata.dataset import Dataset
+from seannet.data.opening import DataSource, open_dataset
 
 __all__ = [
     "BIN_NAMES",
@@ -67,9 +66,12 @@ def moved_instances(
     return moved
 
 
-def moved_objects(data: Path, split: str, triplets: Sequence[tuple[str, str, str]]) -> np.ndarray:
-    """(T,) number of moved objects in view between each triplet's anchor and positive."""
-    table = Dataset.open(data).observations(split, columns=["obs_id", "layout", "objects"])
+def moved_objects(
+    data: DataSource, split: str, triplets: Sequence[tuple[str, str, str]]
+) -> np.ndarray:
+    """(T,) number of moved objects in view between each triplet's anchor and positive
+    (``data``: an opened dataset, or its root)."""
+    table = open_dataset(data).observations(split, columns=["obs_id", "layout", "objects"])
     ids = table.column("obs_id").to_pylist()
     layouts = table.column("layout").to_pylist()
     boxes: dict[str, dict[int, np.ndarray]] = {}

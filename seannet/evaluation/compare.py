@@ -42,6 +42,7 @@ from typing import Any
 
 import numpy as np
 
+from seannet.data.opening import DataSource, open_dataset
 from seannet.errors import ModelError
 from seannet.evaluation.intervals import (
     per_room_matrix,
@@ -100,7 +101,7 @@ def model_spec(spec: str, base: TrainConfig) -> ModelSpec:
 
 
 def compare_models(
-    data: Path,
+    data: DataSource,
     out: Path,
     models: Sequence[str],
     *,
@@ -114,6 +115,9 @@ def compare_models(
     batches: dict[str, int] | None = None,
 ) -> dict[str, Any]:
     """Select on val, test once; write ``out/selection.json`` then ``out/comparison.{json,md}``.
+
+    ``data`` (the dataset's root, or the dataset opened already) is opened once, here, and
+    the opened dataset is what training, calibration and evaluation are handed.
 
     Runs live in ``out/<trained spec>/lr<lr>/seed<k>``; a run that has a checkpoint resumes,
     so an interrupted comparison picks up where it stopped.
@@ -140,6 +144,7 @@ def compare_models(
     say = announce or (lambda _text: None)
     base = load_preset(preset) if isinstance(preset, str) else preset
     specs = [model_spec(name, base) for name in models]  # refuse a bad spec before work
+    ds = open_dataset(data)  # the manifest read once for the whole comparison
     batches = dict(batches or {})
     calibrations: dict[str, Calibration] = {}
     chosen = []
@@ -147,10 +152,10 @@ def compare_models(
         config = spec.config
         if budget_s is not None or spec.trained in batches:
             if spec.trained not in batches:
-                calibrations[spec.trained] = _calibrate(spec.trained, config, data, budget_s, say)
+                calibrations[spec.trained] = _calibrate(spec.trained, config, ds, budget_s, say)
                 batches[spec.trained] = calibrations[spec.trained].batches
             config = config.replace(max_train_batches=batches[spec.trained])
-        choice = _select(spec, config, data, out, seeds, lrs or (config.lr,), say)
+        choice = _select(spec, config, ds, out, seeds, lrs or (config.lr,), say)
         got = calibrations.get(spec.trained)
         # what the budget bought and how it was measured; or where the batches came from
         source = "recorded" if spec.trained in batches else "preset"
@@ -172,9 +177,9 @@ def compare_models(
     entries = []
     for spec, choice in zip(specs, chosen, strict=True):
         say(f"{spec.spec}: test, lr {choice['lr']:g}")
-        runs = [evaluate_run(Path(r), data, split="test", boxes=spec.boxes) for r in choice["runs"]]
+        runs = [evaluate_run(Path(r), ds, split="test", boxes=spec.boxes) for r in choice["runs"]]
         entries.append({**choice, "summary": summarize(runs), "runs": runs})
-    counts = triplets_per_room(data, "test")
+    counts = triplets_per_room(ds, "test")
     for entry in entries:
         entry["summary"]["two_level"] = _two_level(entry["runs"], counts)
     for entry in entries[1:]:
@@ -188,7 +193,7 @@ def compare_models(
 def _select(
     spec: ModelSpec,
     config: TrainConfig,
-    data: Path,
+    ds: Dataset,
     out: Path,
     seeds: Sequence[int],
     lrs: Sequence[float],
@@ -199,15 +204,15 @@ def _select(
     for lr in lrs:
         run = _run_dir(out, spec.trained, lr, seeds[0])
         say(f"{spec.spec}: lr {lr:g}, seed {seeds[0]} -> {run}")
-        _train(config.replace(lr=lr, seed=seeds[0]), data, run, spec.pretrained)
-        sweep[lr] = evaluate_run(run, data, split="val", boxes=spec.boxes)["accuracy"]
+        _train(config.replace(lr=lr, seed=seeds[0]), ds, run, spec.pretrained)
+        sweep[lr] = evaluate_run(run, ds, split="val", boxes=spec.boxes)["accuracy"]
     lr = max(sweep, key=lambda k: (sweep[k], -k))  # best val accuracy; ties: the smaller
     runs = []
     for seed in seeds:
         run = _run_dir(out, spec.trained, lr, seed)
         if seed != seeds[0]:
             say(f"{spec.spec}: lr {lr:g}, seed {seed} -> {run}")
-            _train(config.replace(lr=lr, seed=seed), data, run, spec.pretrained)
+            _train(config.replace(lr=lr, seed=seed), ds, run, spec.pretrained)
         runs.append(str(run))
     return {
         "model": spec.spec,
@@ -226,12 +231,12 @@ def _select(
 def _calibrate(
     trained: str,
     config: TrainConfig,
-    data: Path,
+    ds: Dataset,
     budget_s: float,
     say: Callable[[str], None],
 ) -> Calibration:
     """The budget's batches for one network, announced; a disturbed timing is a warning."""
-    got = calibrate(config, data, budget_s)
+    got = calibrate(config, ds, budget_s)
     say(
         f"{trained}: {got.batches} batches per epoch fill {budget_s:g} s of one thread "
         f"(a step {got.step_s:.3f} s, rounds {100 * got.spread:.0f} % apart)"
@@ -251,8 +256,8 @@ def _run_dir(out: Path, name: str, lr: float, seed: int) -> Path:
     return out / name / f"lr{lr:g}" / f"seed{seed}"
 
 
-def _train(config: TrainConfig, data: Path, run: Path, pretrained: Path | None) -> None:
-    train(config, data, run, resume=(run / LAST).exists(), pretrained=pretrained)
+def _train(config: TrainConfig, ds: Dataset, run: Path, pretrained: Path | None) -> None:
+    train(config, ds, run, resume=(run / LAST).exists(), pretrained=pretrained)
 
 
 def summarize(runs: list[dict[str, Any]]) -> dict[str, Any]:
@@ -300,9 +305,10 @@ def _difference(
     }
 
 
-def triplets_per_room(data: Path, split: str) -> dict[str, int]:
-    """How many ``split`` triplets each room holds (from the dataset's triplet table)."""
-    rooms = Dataset.open(data).triplets(split)
+def triplets_per_room(data: DataSource, split: str) -> dict[str, int]:
+    """How many ``split`` triplets each room holds (from the dataset's triplet table;
+    ``data``: the dataset opened, or its root)."""
+    rooms = open_dataset(data).triplets(split)
     names, counts = np.unique(rooms.column("room_id").to_numpy(), return_counts=True)
     return {str(n): int(c) for n, c in zip(names, counts, strict=True)}
 

@@ -25,8 +25,10 @@ from pathlib import Path
 import numpy as np
 
 from seannet.data.box_noise import BoxNoise
+from seannet.data.opening import DataSource
 from seannet.evaluation.metrics import Embeddings
 from seannet.training.runs import BEST
+from sgdata.dataset import Dataset
 from sgdata.dataset.paths import MANIFEST
 from sgdata.fileio import atomic_write_bytes, sha256_file
 
@@ -58,18 +60,18 @@ _ARRAYS = ("vectors", "room", "layout", "grid_i", "grid_j", "heading")
 
 def cached_embeddings(
     run: Path,
-    data: Path,
+    data: DataSource,
     split: str,
     noise: BoxNoise | None,
     embed: Callable[[], Embeddings],
 ) -> Embeddings:
-    """``embed()``, or what it returned for the same checkpoint, dataset, split, noise and
-    embedding code."""
+    """``embed()``, or what it returned for the same checkpoint, dataset (opened, or its
+    root), split, noise and embedding code."""
     key = json.dumps(
         {
             "checkpoint_sha256": sha256_file(run / BEST)[0],
             "code_sha256": embedding_code_sha256(),
-            "manifest_sha256": sha256_file(data / MANIFEST)[0],
+            "manifest_sha256": _manifest_sha256(data),
             "split": split,
             "noise": asdict(noise) if noise is not None and noise.active else None,
         },
@@ -109,6 +111,14 @@ def _embeddings(stored: np.lib.npyio.NpzFile) -> Embeddings:
         slot_boxes=(stored["box_offsets"], stored["box_slots"], stored["boxes"]),
         num_slots=int(stored["num_slots"]),
     )
+
+
+def _manifest_sha256(data: DataSource) -> str:
+    """The fingerprint of the dataset: an opened one's, read with its manifest (nothing is
+    read again), or the file's at ``data/dataset.json`` for a root."""
+    if isinstance(data, Dataset):
+        return data.manifest_sha256
+    return sha256_file(Path(data) / MANIFEST)[0]
 
 
 @functools.cache

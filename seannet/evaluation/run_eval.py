@@ -16,8 +16,9 @@ import numpy as np
 from PIL import Image, ImageDraw, ImageFont
 
 from seannet.data.box_noise import BoxNoise
-from seannet.data.datasets import ImageTransform, ObservationDataset, TripletDataset, open_dataset
+from seannet.data.datasets import ImageTransform, ObservationDataset, TripletDataset
 from seannet.data.moved import moved_objects
+from seannet.data.opening import DataSource, open_dataset
 from seannet.errors import DataError
 from seannet.evaluation.box_kernel import SlotPairs, fit_box_kernel, slot_pairs
 from seannet.evaluation.box_overlap import SlotBoxes, choose_box_weight
@@ -38,6 +39,7 @@ from seannet.evaluation.metrics import (
 from seannet.evaluation.retrieval import accuracy_by_moved, map_recall, separation
 from seannet.model.specs import SCENE_TERMS
 from seannet.training.runs import MODEL_KEYS, restore_run
+from sgdata.dataset import Dataset
 from sgdata.errors import SgdataError
 from sgdata.fileio import atomic_write_text, save_png
 
@@ -46,7 +48,7 @@ __all__ = ["draw_heatmap", "eval_file", "evaluate_run"]
 
 def evaluate_run(
     run: Path,
-    data: Path,
+    data: DataSource,
     *,
     split: str = "test",
     out: Path | None = None,
@@ -54,6 +56,9 @@ def evaluate_run(
     noise: BoxNoise | None = None,
 ) -> dict:
     """Evaluate ``run/best.pt`` on ``split`` of ``data``; writes ``eval_<split><tag>.*`` files.
+
+    ``data`` is an opened dataset (:func:`~seannet.data.opening.open_dataset`) or its root,
+    opened once here; everything below is handed the opened dataset.
 
     Every choice is read off the validation split (epsilon; with ``boxes``, lambda), under
     the same box noise as ``split``; the split evaluated only gives figures.
@@ -75,16 +80,16 @@ def evaluate_run(
     out = out or run
     ds = open_dataset(data)
     # photos: another dataset by design, but the same vocabulary
-    restored = restore_run(run, data, keys=MODEL_KEYS if _all_real(ds, split) else None)
+    restored = restore_run(run, ds, keys=MODEL_KEYS if _all_real(ds, split) else None)
     config, model, device, state = restored.config, restored.model, restored.device, restored.state
 
     def embedded(name: str) -> Embeddings:
-        compute = lambda: embed_split(model, config, data, name, device, noise=noise)  # noqa: E731
-        return cached_embeddings(run, data, name, noise, compute)
+        compute = lambda: embed_split(model, config, ds, name, device, noise=noise)  # noqa: E731
+        return cached_embeddings(run, ds, name, noise, compute)
 
     evaluated = embedded(split)
     transform = ImageTransform.for_model(config.model.image_size, config.model.image_family)
-    triplets = TripletDataset(data, split, transform=transform)
+    triplets = TripletDataset(ds, split, transform=transform)
     s_ap, s_an = triplet_similarities(evaluated, triplets)
     val = None
     if "val" in ds.splits:
@@ -93,11 +98,13 @@ def evaluate_run(
     choices: dict[str, Any] = {}
     if boxes:
         if val is None:
-            raise DataError(f"{data}: {boxes} chooses lambda on the val split, and there is none")
+            raise DataError(
+                f"{ds.root}: {boxes} chooses lambda on the val split, and there is none"
+            )
         val_triplets = (
-            triplets if split == "val" else TripletDataset(data, "val", transform=transform)
+            triplets if split == "val" else TripletDataset(ds, "val", transform=transform)
         )
-        scene = _SceneScores(boxes, data, noise)
+        scene = _SceneScores(boxes, ds, noise)
         choices.update(scene.fit)
         v_ap, v_an = triplet_similarities(val, val_triplets)
         b_ap, b_an = scene.triplets(val, val_triplets)
@@ -106,7 +113,7 @@ def evaluate_run(
         s_ap, s_an = s_ap + weight * o_ap, s_an + weight * o_an
         choices["box_weight"] = {"lambda": weight, "val_accuracy_by_lambda": by_weight}
     metrics = triplet_metrics(triplets, s_ap, s_an)
-    moved = moved_objects(data, split, triplets.obs)
+    moved = moved_objects(ds, split, triplets.obs)
     if val is not None:
         threshold = choose_threshold(val)
         rule = "max balanced accuracy, same pose vs one step (val)"
@@ -163,16 +170,17 @@ class _SceneScores:
     """``S_scene(A, P)`` and ``S_scene(A, N)`` of triplets, from the boxes the model saw:
     the hand-made overlap, or the kernel fit on the train triplets' boxes (same noise)."""
 
-    def __init__(self, term: str, data: Path, noise: BoxNoise | None) -> None:
+    def __init__(self, term: str, ds: Dataset, noise: BoxNoise | None) -> None:
         self.kernel = None
         self.fit: dict[str, Any] = {}
         if term == "+box-kernel":
-            ds = open_dataset(data)
             if "train" not in ds.splits:
-                raise DataError(f"{data}: +box-kernel learns on the train split, and there is none")
-            views = ObservationDataset(data, "train", noise=noise)
+                raise DataError(
+                    f"{ds.root}: +box-kernel learns on the train split, and there is none"
+                )
+            views = ObservationDataset(ds, "train", noise=noise)
             boxes = SlotBoxes(views.obs_ids, *views.slot_boxes(), views.num_slots)
-            positive, negative = self._pairs(boxes, TripletDataset(data, "train").obs)
+            positive, negative = self._pairs(boxes, TripletDataset(ds, "train").obs)
             self.kernel, accuracy = fit_box_kernel(positive, negative, views.num_slots)
             self.fit = {
                 "box_kernel": {"train_triplets": positive.pairs, "train_accuracy": accuracy}
@@ -197,7 +205,7 @@ class _SceneScores:
         return self.kernel.score(positive), self.kernel.score(negative)
 
 
-def _all_real(ds, split: str) -> bool:  # noqa: ANN001
+def _all_real(ds: Dataset, split: str) -> bool:
     """Whether every observation of ``split`` is a real photo (``domain = "real"``)."""
     try:
         domains = ds.observations(split, columns=["domain"]).column("domain").to_pylist()

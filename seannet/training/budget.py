@@ -30,7 +30,6 @@ import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import asdict, dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -38,6 +37,7 @@ import torch
 from torch.utils.data import DataLoader
 
 from seannet.data.datasets import ImageTransform, TripletDataset, collate_triplets
+from seannet.data.opening import DataSource, open_dataset
 from seannet.errors import ModelError
 from seannet.model.loss import TripletLoss
 from seannet.training.config import TrainConfig
@@ -97,7 +97,7 @@ def _one_thread() -> Iterator[None]:
 
 def calibrate(
     config: TrainConfig,
-    data: Path,
+    data: DataSource,
     budget_s: float,
     *,
     batches: int = _BATCHES,
@@ -132,10 +132,11 @@ def calibrate(
         marks.append((clock(), time.perf_counter()))
 
     with _one_thread():
-        model = build_for_dataset(config, data).to(device)
+        dataset = open_dataset(data)
+        model = build_for_dataset(config, dataset).to(device)
         optimizer = torch.optim.SGD(param_groups(model, config), lr=config.lr, momentum=0.9)
         triplets = TripletDataset(
-            data,
+            dataset,
             "train",
             transform=ImageTransform.for_model(config.model.image_size, config.model.image_family),
         )
@@ -169,6 +170,6 @@ def calibrate(
     )
 
 
-def calibrate_batches(config: TrainConfig, data: Path, budget_s: float) -> int:
+def calibrate_batches(config: TrainConfig, data: DataSource, budget_s: float) -> int:
     """Batches per epoch that fill ``budget_s`` (:func:`calibrate`'s ``batches``)."""
     return calibrate(config, data, budget_s).batches

@@ -11,7 +11,7 @@ from typing import Any
 
 import torch
 
-from seannet.data.datasets import dataset_identity, open_dataset
+from seannet.data.opening import DataSource, dataset_identity, open_dataset
 from seannet.errors import CheckpointError
 from seannet.model.factory import build_model
 from seannet.training.config import TrainConfig
@@ -46,12 +46,13 @@ def device_for_run() -> torch.device:
 
 def build_for_dataset(  # noqa: ANN201
     config: TrainConfig,
-    root: Path,
+    root: DataSource,
     *,
     pretrained: Path | None = None,
     pretrained_sha256: str | None = None,
 ):
-    """The model of ``config`` sized for the dataset at ``root`` (its class vocabulary, M)."""
+    """The model of ``config`` sized for the dataset ``root`` (an opened dataset or its root):
+    its class vocabulary, M."""
     dataset = open_dataset(root)
     return build_model(
         config.model,
@@ -74,8 +75,9 @@ class RestoredRun:
     state: dict[str, Any]
 
 
-def restore_run(run: Path, data: Path, *, keys: Sequence[str] | None = None) -> RestoredRun:
-    """``run/best.pt`` built for ``data`` with its trained weights.
+def restore_run(run: Path, data: DataSource, *, keys: Sequence[str] | None = None) -> RestoredRun:
+    """``run/best.pt`` built for ``data`` (an opened dataset or its root) with its trained
+    weights.
 
     Args:
         keys: the dataset identity fields that must match the run's (default: all of them;
@@ -84,16 +86,17 @@ def restore_run(run: Path, data: Path, *, keys: Sequence[str] | None = None) -> 
     Raises:
         CheckpointError: no checkpoint, or it was trained on another dataset.
     """
+    dataset = open_dataset(data)
     path = run / BEST
     state = load_checkpoint(path)
-    saved, current = state["dataset"], dataset_identity(data)
+    saved, current = state["dataset"], dataset_identity(dataset)
     if keys is not None:
         saved = {k: saved.get(k) for k in keys}
         current = {k: current.get(k) for k in keys}
     check_same_dataset(path, saved, current)
     config = TrainConfig.from_dict(state["config"])
     device = device_for_run()
-    model = build_for_dataset(config, data).to(device)
+    model = build_for_dataset(config, dataset).to(device)
     model.load_state_dict(state["model"])
     return RestoredRun(path, config, model.eval(), device, state)
 

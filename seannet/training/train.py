@@ -17,12 +17,8 @@ import numpy as np
 import torch
 from torch.utils.data import DataLoader, Subset
 
-from seannet.data.datasets import (
-    ImageTransform,
-    TripletDataset,
-    collate_triplets,
-    dataset_identity,
-)
+from seannet.data.datasets import ImageTransform, TripletDataset, collate_triplets
+from seannet.data.opening import DataSource, dataset_identity, open_dataset
 from seannet.errors import CheckpointError
 from seannet.model.loss import TripletLoss
 from seannet.model.pretrained import check_pretrained_request
@@ -72,7 +68,7 @@ def param_groups(model: torch.nn.Module, config: TrainConfig) -> list[dict[str, 
 
 def train(
     config: TrainConfig,
-    data: Path,
+    data: DataSource,
     out: Path,
     *,
     resume: bool = False,
@@ -80,7 +76,8 @@ def train(
     pretrained_sha256: str | None = None,
     progress: Progress | None = None,
 ) -> list[EpochResult]:
-    """Train ``config.model`` on ``data`` into the run directory ``out``.
+    """Train ``config.model`` on ``data`` (an opened dataset or its root: opened once here)
+    into the run directory ``out``.
 
     Writes ``last.pt`` after every epoch (whole: model, optimiser and schedule, to resume),
     ``best.pt`` when validation accuracy improves (the model only: what evaluation reads) and
@@ -93,14 +90,15 @@ def train(
         ModelError: ``pretrained_sha256`` without ``pretrained``, or not 64 hex digits.
     """
     check_pretrained_request(pretrained, pretrained_sha256)
-    identity = dataset_identity(data)
+    dataset = open_dataset(data)
+    identity = dataset_identity(dataset)
     transform = ImageTransform.for_model(config.model.image_size, config.model.image_family)
-    train_set = TripletDataset(data, "train", transform=transform)
-    val_set = TripletDataset(data, "val", transform=transform)
+    train_set = TripletDataset(dataset, "train", transform=transform)
+    val_set = TripletDataset(dataset, "val", transform=transform)
     device = device_for_run()
     torch.manual_seed(init_seed(config.seed))  # the initial weights
     model = build_for_dataset(
-        config, data, pretrained=pretrained, pretrained_sha256=pretrained_sha256
+        config, dataset, pretrained=pretrained, pretrained_sha256=pretrained_sha256
     ).to(device)
     optimizer = torch.optim.SGD(param_groups(model, config), lr=config.lr, momentum=config.momentum)
     schedule = torch.optim.lr_scheduler.StepLR(optimizer, config.decay_every, config.lr_decay)
@@ -121,7 +119,7 @@ def train(
         history, best, start_epoch = state["history"], state["best"], state["epoch"] + 1
     elif last.exists():
         raise CheckpointError(f"{out}: holds a run already; pass --resume or pick another --out")
-    append_provenance(out, data, step="resume" if resume else "train")  # makes ``out``
+    append_provenance(out, dataset, step="resume" if resume else "train")  # makes ``out``
     loss_fn = TripletLoss(config.margin)
     results = [EpochResult(**h) for h in history]
     for epoch in range(start_epoch, config.epochs):

@@ -1,0 +1,83 @@
+"""A command opens its dataset once (STYLE.md habit 15): ``dataset.json`` is read one time per
+``compare``, ``eval`` or ``train``, however many loaders, checkpoints and records sit below."""
+
+from __future__ import annotations
+
+import builtins
+import io
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from seannet.evaluation.compare import compare_models
+from seannet.evaluation.run_eval import evaluate_run
+from seannet.training.config import TrainConfig
+from seannet.training.train import train
+from sgdata.dataset.paths import MANIFEST
+
+TINY = TrainConfig().replace(
+    model="resnet18",
+    image_size=64,
+    embed_dim=64,
+    epochs=1,
+    batch_size=2,
+    max_train_batches=1,
+    num_workers=0,
+)
+
+
+class ManifestReads:
+    """Counts every opening of a ``dataset.json`` in this process (``open``, ``io.open`` and
+    so ``Path.read_text`` / ``read_bytes``), by file."""
+
+    def __init__(self) -> None:
+        self.paths: list[Path] = []
+
+    def wrap(self, real: Any) -> Any:
+        def counted(file: Any, *args: Any, **kwargs: Any) -> Any:
+            if isinstance(file, (str, Path)) and Path(file).name == MANIFEST:
+                self.paths.append(Path(file).resolve())
+            return real(file, *args, **kwargs)
+
+        return counted
+
+    def of(self, root: Path) -> int:
+        return self.paths.count((root / MANIFEST).resolve())
+
+
+@pytest.fixture
+def manifest_reads(monkeypatch: pytest.MonkeyPatch) -> Iterator[ManifestReads]:
+    reads = ManifestReads()
+    real = io.open
+    monkeypatch.setattr(io, "open", reads.wrap(real))
+    monkeypatch.setattr(builtins, "open", reads.wrap(real))
+    yield reads
+
+
+def test_compare_reads_the_manifest_once(
+    tmp_path: Path, mini_dataset: Path, manifest_reads: ManifestReads
+) -> None:
+    # calibration, training (loaders, model, checkpoint identity, provenance), evaluation on
+    # val and test with and without the box term (embedding cache key, moved objects), counts
+    compare_models(
+        mini_dataset,
+        tmp_path / "cmp",
+        ["resnet18", "resnet18+boxes"],
+        preset=TINY,
+        seeds=(0,),
+        lrs=(0.01,),
+        budget_s=0.001,
+    )
+    assert manifest_reads.of(mini_dataset) == 1
+
+
+def test_train_and_eval_read_the_manifest_once_each(
+    tmp_path: Path, mini_dataset: Path, manifest_reads: ManifestReads
+) -> None:
+    run = tmp_path / "run"
+    train(TINY, mini_dataset, run)
+    assert manifest_reads.of(mini_dataset) == 1
+    evaluate_run(run, mini_dataset, split="val", boxes="+box-kernel")
+    assert manifest_reads.of(mini_dataset) == 2
