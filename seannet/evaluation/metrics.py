@@ -17,7 +17,6 @@ from __future__ import annotations
 
 from collections import defaultdict
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -31,6 +30,8 @@ from seannet.data.datasets import (
     TripletDataset,
     collate_views,
 )
+from seannet.data.opening import DataSource
+from seannet.data.poses import HEADINGS
 from seannet.model.loss import similarity
 from seannet.training.config import TrainConfig
 from seannet.training.loop import collect, embed_batch
@@ -73,13 +74,14 @@ class Embeddings:
 def embed_split(
     model: torch.nn.Module,
     config: TrainConfig,
-    data: Path,
+    data: DataSource,
     split: str,
     device: torch.device,
     *,
     noise: BoxNoise | None = None,
 ) -> Embeddings:
-    """Embed every observation of ``split`` once (eval mode), its boxes under ``noise``."""
+    """Embed every observation of ``split`` of ``data`` (an opened dataset, or its root) once
+    (eval mode), its boxes under ``noise``."""
     dataset = ObservationDataset(
         data,
         split,
@@ -146,7 +148,7 @@ def _pairs(embeddings: Embeddings) -> tuple[np.ndarray, np.ndarray, np.ndarray, 
     """(delta i, delta j, similarity, same-layout) of all same-room same-heading pairs."""
     di, dj, sims, same = [], [], [], []
     for room in sorted(set(embeddings.room)):
-        for heading in range(4):
+        for heading in range(HEADINGS):
             k = np.nonzero((embeddings.room == room) & (embeddings.heading == heading))[0]
             if len(k) < 2:
                 continue

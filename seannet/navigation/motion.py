@@ -9,6 +9,8 @@ degrees in place.
 
 from __future__ import annotations
 
+from seannet.data.poses import HEADINGS
+
 __all__ = [
     "ACTIONS",
     "FORWARD",
@@ -20,7 +22,6 @@ __all__ = [
     "turn_towards",
 ]
 
-HEADINGS = 4
 # heading index -> the unit grid step (di, dj) of moving forward
 FORWARD = ((1, 0), (0, 1), (-1, 0), (0, -1))
 NAVIGATOR_ACTIONS = ("forward", "left", "right")  # the navigator's logits, in this order

@@ -26,12 +26,11 @@ from sgdata.label.models import PhotoLabels
 from sgdata.label.photos import DEFAULT_MAX_PIXELS, Photo, photo_bytes, scan_photos
 from sgdata.label.proposals import DEFAULT_RULES, RELATION_NAMES, ProposalRules
 from sgdata.label.store import LabelStore
-from sgdata.world.triplets import RoomPoses, Triplet, sample_triplets
+from sgdata.world.triplets import HEADINGS, RoomPoses, Triplet, sample_triplets
 
 __all__ = ["ExportSummary", "export_dataset", "SOURCE", "FILE_SEP"]
 
 SOURCE = "sgdata label"  # config.source of an export: re-exporting may replace only these
-HEADINGS = 4
 FILE_SEP = "__"  # stands for the '/' of an obs_id in a file name (Label Studio image files)
 
 

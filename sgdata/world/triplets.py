@@ -51,6 +51,7 @@ import numpy as np
 
 from sgdata.errors import ConfigError
 from sgdata.seeds import triplet_stream_seed
+from sgdata.world.poses import HEADINGS_DEG
 
 __all__ = [
     "OffsetRule",
@@ -68,7 +69,7 @@ __all__ = [
     "referenced_poses_by_room",
 ]
 
-HEADINGS = 4  # 0/90/180/270 degrees
+HEADINGS = len(HEADINGS_DEG)  # 0/90/180/270 degrees (sgdata.world.poses, their home)
 MAX_DISTANCE = 4  # the largest |α|+|β| any tier uses; also the grid padding below
 _DEDUP_ROUNDS = 16  # redraw rounds against duplicates before accepting them (never loop forever)
 _SHARE_TOLERANCE = 1e-6  # shares must sum to 1 within this
