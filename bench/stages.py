@@ -55,6 +55,7 @@ from sgdata.pipeline import room_tasks  # noqa: E402
 from sgdata.pipeline.config import GenerateConfig, load_config  # noqa: E402
 from sgdata.pipeline.ledger import read_record, scene_record  # noqa: E402
 from sgdata.stage_clock import OTHER, StageClock  # noqa: E402
+from sgdata.world.poses import HEADINGS_DEG  # noqa: E402
 from sgdata.world.triplets import PoseKey  # noqa: E402
 
 PNG_LEVELS = (1, 3, 6, 9)
@@ -74,7 +75,7 @@ def sample_views(record: dict, count: int, rng: np.random.Generator) -> list[Pos
         PoseKey(int(layout), int(i), int(j), heading)
         for layout, cells in sorted(record["reachable"].items(), key=lambda kv: int(kv[0]))
         for i, j in cells
-        for heading in range(4)
+        for heading in range(len(HEADINGS_DEG))
     ]
     if len(keys) <= count:
         return keys

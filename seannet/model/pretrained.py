@@ -9,8 +9,10 @@ weights for that architecture (the same check ``torch.hub`` makes with ``check_h
 from __future__ import annotations
 
 import re
+import warnings
 from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
 import torch
 from torch import Tensor, nn
@@ -21,7 +23,6 @@ from sgdata.fileio import sha256_file
 
 __all__ = [
     "check_pretrained_request",
-    "file_sha256",
     "load_state_dict_file",
     "load_pretrained",
 ]
@@ -47,11 +48,6 @@ def check_pretrained_request(path: Path | None, sha256: str | None) -> None:
             f"--pretrained-sha256 {sha256!r}: expected 8 to 64 hex digits of the file's "
             f"sha256 (`sha256sum {path}`)"
         )
-
-
-def file_sha256(path: Path) -> str:
-    """Hex SHA-256 of a file (the dataset's own digest function)."""
-    return sha256_file(path)[0]
 
 
 def _check_hash(path: Path, actual: str, arch: str, sha256: str | None) -> None:
@@ -92,7 +88,7 @@ def load_state_dict_file(path: Path, *, arch: str, sha256: str | None = None) ->
     path = Path(path)
     if not path.is_file():
         raise ModelError(f"pretrained weights {path}: no such file")
-    _check_hash(path, file_sha256(path), arch, sha256)
+    _check_hash(path, sha256_file(path)[0], arch, sha256)
     try:
         # weights_only: never unpickle arbitrary objects from a weights file
         obj = torch.load(path, map_location="cpu", weights_only=True)
@@ -137,3 +133,21 @@ def load_pretrained(
         )
     model.load_state_dict(state, strict=True)
     return model
+
+
+def _file_sha256(path: Path) -> str:
+    return sha256_file(path)[0]
+
+
+def __getattr__(name: str) -> Any:
+    """``file_sha256`` is ``sgdata.fileio.sha256_file(path)[0]`` (one home for hashing a file);
+    the old name is served for one release."""
+    if name == "file_sha256":
+        warnings.warn(
+            "seannet.model.pretrained.file_sha256 moved to sgdata.fileio.sha256_file "
+            "(use sha256_file(path)[0]; the old name goes in the next release)",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return _file_sha256
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -35,7 +35,6 @@ from PIL import Image, ImageDraw, ImageFont
 from seannet.data.datasets import dataset_identity, open_dataset
 from seannet.data.live_views import LiveRooms
 from seannet.errors import NavigationError
-from seannet.model.pretrained import file_sha256
 from seannet.navigation.config import MAP_SPACING, NavigationTestConfig
 from seannet.navigation.episodes import CASES, EpisodeResult, run_episode, sample_episode
 from seannet.navigation.localizer import Localizer, load_localizer
@@ -53,7 +52,7 @@ from seannet.navigation.tables import markdown, write_results
 from seannet.provenance import append_provenance
 from seannet.seeds import episode_seed
 from seannet.training.runs import BEST, check_same_dataset, load_checkpoint
-from sgdata.fileio import atomic_write_text, save_png
+from sgdata.fileio import atomic_write_text, save_png, sha256_file
 from sgdata.pipeline.executors import run_tasks
 from sgdata.seeds import rng_for
 
@@ -130,7 +129,7 @@ def run_navigation(
     settings = {
         **config.settings(),
         "navigator": str(navigator) if navigator is not None else ORACLE,
-        "navigator_sha256": file_sha256(navigator / BEST) if navigator is not None else ORACLE,
+        "navigator_sha256": sha256_file(navigator / BEST)[0] if navigator is not None else ORACLE,
         "dataset": identity,
     }
     labels = dict(zip(runs, run_labels(runs), strict=True))

@@ -20,10 +20,10 @@ import torch
 from seannet.data.datasets import ImageTransform, ViewTensors, collate_views
 from seannet.errors import NavigationError
 from seannet.evaluation.run_eval import eval_file
-from seannet.model.pretrained import file_sha256
 from seannet.training.config import TrainConfig
 from seannet.training.loop import collect, embed_batch
 from seannet.training.runs import restore_run
+from sgdata.fileio import sha256_file
 
 __all__ = ["Localizer", "load_localizer", "run_epsilon"]
 
@@ -126,6 +126,6 @@ def load_localizer(
         epsilon=float(epsilon),
         epsilon_source=source,
         identity=restored.state["dataset"],
-        digest=file_sha256(restored.path),
+        digest=sha256_file(restored.path)[0],
         device=restored.device,
     )

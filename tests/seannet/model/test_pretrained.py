@@ -9,8 +9,9 @@ import torch
 from torchvision import models
 
 from seannet import ImageEncoder, ModelError, SeanNet, build_model
-from seannet.model.pretrained import file_sha256, load_pretrained, load_state_dict_file
+from seannet.model.pretrained import load_pretrained, load_state_dict_file
 from seannet.weights import NETWORKS, NetworkRecord
+from sgdata.fileio import sha256_file
 
 
 @pytest.fixture(scope="module")
@@ -38,7 +39,7 @@ def test_known_hashes_are_torchvisions() -> None:
 
 def test_right_hash_loads_the_weights(resnet18_file: tuple[Path, dict]) -> None:
     path, state = resnet18_file
-    digest = file_sha256(path)
+    digest = sha256_file(path)[0]
     model = ImageEncoder("resnet18", pretrained=path, pretrained_sha256=digest)
     got = model.encoder.state_dict()
     assert all(torch.equal(got[k], v) for k, v in state.items() if not k.startswith("fc."))
@@ -53,7 +54,7 @@ def test_right_hash_loads_the_weights(resnet18_file: tuple[Path, dict]) -> None:
 
 def test_wrong_hash_names_expected_and_actual(resnet18_file: tuple[Path, dict]) -> None:
     path, _ = resnet18_file
-    actual = file_sha256(path)
+    actual = sha256_file(path)[0]
     wrong = "0" * 64
     with pytest.raises(ModelError) as err:
         ImageEncoder("resnet18", pretrained=path, pretrained_sha256=wrong)
@@ -65,7 +66,7 @@ def test_wrong_hash_names_expected_and_actual(resnet18_file: tuple[Path, dict]) 
 
 def test_unknown_file_without_hash_is_refused(resnet18_file: tuple[Path, dict]) -> None:
     path, _ = resnet18_file
-    actual = file_sha256(path)
+    actual = sha256_file(path)[0]
     with pytest.raises(ModelError, match=f"sha256 {actual} matches no known resnet18.*f37072fd"):
         ImageEncoder("resnet18", pretrained=path)
 
@@ -74,7 +75,7 @@ def test_known_prefix_is_accepted(
     resnet18_file: tuple[Path, dict], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     path, state = resnet18_file
-    local = NetworkRecord("resnet18", {"local.pth": file_sha256(path)[:8]})
+    local = NetworkRecord("resnet18", {"local.pth": sha256_file(path)[0][:8]})
     monkeypatch.setitem(NETWORKS, "resnet18", local)
     model = load_pretrained(models.resnet18(weights=None), path, arch="resnet18")
     assert torch.equal(model.conv1.weight, state["conv1.weight"])
@@ -84,11 +85,11 @@ def test_not_a_state_dict(tmp_path: Path) -> None:
     listed = tmp_path / "list.pth"
     torch.save([torch.zeros(2)], listed)
     with pytest.raises(ModelError, match="holds a list, not a state_dict"):
-        load_state_dict_file(listed, arch="resnet18", sha256=file_sha256(listed))
+        load_state_dict_file(listed, arch="resnet18", sha256=sha256_file(listed)[0])
     text = tmp_path / "notes.pth"
     text.write_text("not weights\n")
     with pytest.raises(ModelError, match="not a torch state_dict file"):
-        load_state_dict_file(text, arch="resnet18", sha256=file_sha256(text))
+        load_state_dict_file(text, arch="resnet18", sha256=sha256_file(text)[0])
     with pytest.raises(ModelError, match="no such file"):
         load_state_dict_file(tmp_path / "absent.pth", arch="resnet18")
 
@@ -97,7 +98,7 @@ def test_weights_of_another_architecture_do_not_fit(tmp_path: Path) -> None:
     path = tmp_path / "linear.pth"
     torch.save(torch.nn.Linear(3, 2).state_dict(), path)
     with pytest.raises(ModelError, match=r"do not fit resnet18: \d+ missing .*2 unexpected"):
-        ImageEncoder("resnet18", pretrained=path, pretrained_sha256=file_sha256(path))
+        ImageEncoder("resnet18", pretrained=path, pretrained_sha256=sha256_file(path)[0])
 
 
 def test_an_expected_sha256_that_cannot_be_used_is_refused(tmp_path: Path) -> None:
@@ -110,3 +111,11 @@ def test_an_expected_sha256_that_cannot_be_used_is_refused(tmp_path: Path) -> No
         check_pretrained_request(tmp_path / "w.pth", "WRONG")
     check_pretrained_request(tmp_path / "w.pth", "ab" * 32)  # usable: no error
     check_pretrained_request(None, None)
+
+
+def test_file_sha256_is_sha256_file_under_its_old_name(tmp_path: Path) -> None:
+    path = tmp_path / "w.bin"
+    path.write_bytes(b"weights")
+    with pytest.warns(DeprecationWarning, match="sgdata.fileio.sha256_file"):
+        from seannet.model.pretrained import file_sha256
+    assert file_sha256(path) == sha256_file(path)[0]
