@@ -277,8 +277,8 @@ def render(
     config: Annotated[
         str | None,
         typer.Option(
-            help="A generation config (TOML or preset) whose [camera], [poses] and [annotation] "
-            "the view follows (default: the defaults of sgdata generate)."
+            help="A generation config (TOML or preset) whose [camera], [poses], [annotation] "
+            "and [catalog] the view follows (default: the defaults of sgdata generate)."
         ),
     ] = None,
 ) -> None:
@@ -310,6 +310,7 @@ def render(
         camera=settings.camera,
         poses=settings.poses,
         annotation=settings.annotation,
+        catalog=settings.catalog.load(),  # a config's [catalog] files: its mesh classes
         textures=textures,
     )
     overlay_path = output.with_suffix(".overlay.png")

@@ -97,6 +97,15 @@ def test_generate_with_mesh_classes_end_to_end(tmp_path: Path) -> None:
     assert checked.returncode == 0, checked.stdout + checked.stderr
     assert "sources.unchanged" in checked.stdout
 
+    # a view of a layout, checked and annotated with the config's catalog (its mesh classes)
+    for layout in ("0", "1"):
+        view = run(
+            "render", str(one / "scenes" / "kitchen_000"), "--layout", layout,
+            "--config", str(config), "-o", str(tmp_path / f"view_{layout}.png"),
+        )  # fmt: skip
+        assert view.returncode == 0, view.stderr
+        assert (tmp_path / f"view_{layout}.png").is_file()
+
     with open(project / "meshes/plate.stl", "ab") as handle:
         handle.write(b"\n")
     changed = run("validate", str(one), "--quick", "--sources", str(project))
