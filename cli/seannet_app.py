@@ -233,10 +233,19 @@ def networks() -> None:
     typer.echo(network_table(), nl=False)
 
 
-Run = Annotated[Path, typer.Argument(help="Localizer run directory (holds best.pt).")]
+Run = Annotated[
+    str,
+    typer.Argument(
+        help="The localizer: a run directory (best.pt), a method directory (a benchmark card's) "
+        "or a method's name (`seannet methods`)."
+    ),
+]
 Epsilon = Annotated[
     float | None,
-    typer.Option(help="Localization threshold (default: the run's eval_<split>.json epsilon)."),
+    typer.Option(
+        help="Localization threshold (default: the run's eval_<split>.json epsilon, or the "
+        "method directory's, chosen on val)."
+    ),
 ]
 
 
@@ -254,13 +263,13 @@ def build_map(
         MAP_SPACING
     ),
 ) -> None:
-    """Build topological maps (rendered sub-nodes + the run's embeddings), reused if present."""
+    """Build topological maps (rendered sub-nodes + the localizer's vectors), reused if present."""
     from seannet.data.datasets import open_dataset
-    from seannet.navigation.localizer import load_localizer
+    from seannet.navigation.localizer import open_localizer
     from seannet.navigation.maps import build_maps
 
     rooms = room or list(open_dataset(data).rooms(split))
-    localizer = load_localizer(run, data, require_epsilon=False)  # a map needs no epsilon
+    localizer = open_localizer(run, data, require_epsilon=False)  # a map needs no epsilon
     for path in build_maps(localizer, data, rooms, out, layout=layout, spacing=spacing):
         console.print(f"map {path}")
 
@@ -277,7 +286,9 @@ def localize(
         str | None, typer.Option(help="Retrieval metrics on this split instead of queries.")
     ] = None,
     epsilon: Epsilon = None,
-    out: Annotated[Path | None, typer.Option(help="Where to write (default: the run).")] = None,
+    out: Annotated[
+        Path | None, typer.Option(help="Where to write (default: the run or method directory).")
+    ] = None,
 ) -> None:
     """Best-matching map sub-nodes of queries, or recall@1/@5 on a split (other layouts)."""
     from seannet.navigation.map_localization import run_localize
@@ -364,7 +375,13 @@ def train_navigator_command(
 
 @app.command()
 def navigate(
-    runs: Annotated[list[Path], typer.Argument(help="Localizer run directories.")],
+    runs: Annotated[
+        list[str],
+        typer.Argument(
+            help="Localizers: run directories, method directories (benchmark cards') or "
+            "method names."
+        ),
+    ],
     data: Data,
     navigator: Annotated[
         Path | None, typer.Option("--navigator", help="train-navigator run.")
@@ -442,10 +459,26 @@ def benchmark(
     lrs: Annotated[
         str, typer.Option(help="Learning rates a trained method chooses from on val.")
     ] = "",
+    navigator: Annotated[
+        Path | None,
+        typer.Option(
+            "--navigator",
+            help="train-navigator run: also run the navigation test with each method as "
+            "localizer (its rates in the card).",
+        ),
+    ] = None,
+    episodes: Annotated[
+        int, typer.Option(help="Navigation episodes per case (N, A) and room.")
+    ] = NAVIGATION_TEST.episodes,
+    workers: Annotated[int, typer.Option(help="Navigation worker processes.")] = 1,
 ) -> None:
     """DESIGN §12's protocol for any method: choices on val, test once, the change sweep, box
-    noise, cost; one card per method (JSON, markdown, sweep plot)."""
+    noise, cost, and with --navigator the navigation test; one card per method (JSON,
+    markdown, sweep plot)."""
+    from functools import partial
+
     from seannet.methods.benchmark import BenchmarkConfig, benchmark_method
+    from seannet.navigation.method_navigation import navigation_test
 
     try:
         config = BenchmarkConfig(
@@ -455,8 +488,16 @@ def benchmark(
         )  # fmt: skip
     except ValueError:
         raise typer.BadParameter("--seeds takes integers, --lrs numbers, comma-separated") from None
+    navigation = None
+    if navigator is not None:
+        test = NavigationTestConfig(episodes=episodes)
+        navigation = partial(
+            navigation_test, navigator=navigator, data=data, config=test, workers=workers
+        )
     for name in [m.strip() for m in methods.split(",") if m.strip()]:
-        card = benchmark_method(name, data, out, config, announce=console.print)
+        card = benchmark_method(
+            name, data, out, config, announce=console.print, navigation=navigation
+        )
         typer.echo(card.with_name("card.md").read_text())
         console.print(f"wrote {card} and its .md, sweep.png")
 

@@ -11,6 +11,14 @@ For each method (a name, an import path or a model spec, :func:`load_method`) an
    of ``S > epsilon``; the **change sweep** (accuracy by moved objects in view, by their share
    of the anchor's object pixels, by their dynamics class); the box-noise sweep for a method
    with ``uses_boxes``; the cost (ms per view embedded, bytes per map entry).
+4. with a ``navigation`` test given (``seannet benchmark --navigator RUN``): the paper's
+   navigation test with the first seed's method as localizer (its epsilon from val), its
+   success and failure rates in the card.
+
+The first seed's method is kept in the card's directory as a method directory
+(:func:`~seannet.methods.localizer.save_method`: ``method.json``, and ``method.pt`` for a
+trained one), so ``seannet map`` / ``localize`` / ``navigate`` take the card directory as a
+localizer.
 
 Every output a method gives is checked (finite, float, one row per view, one width; a
 similarity in [-1, 1]); any failure, an exception inside the method included, is one
@@ -106,7 +114,7 @@ class _Harness:
         return ImageTransform.for_model(size, str(getattr(self.method, "network", "resnet")))
 
     def loader(self, split: str, noise: BoxNoise | None = None) -> DataLoader:
-        views = ObservationDataset(self.data, split, transform=self.transform(), noise=noise)
+        views = ObservationDataset(self.dataset, split, transform=self.transform(), noise=noise)
         return DataLoader(views, batch_size=self.config.batch_size, collate_fn=collate_views)
 
     def embed(self, split: str, noise: BoxNoise | None = None) -> _Embedded:
@@ -131,7 +139,7 @@ class _Harness:
         )  # fmt: skip
 
     def split_data(self, split: str) -> SplitData:
-        views = ObservationDataset(self.data, split)
+        views = ObservationDataset(self.dataset, split)
         index = {o: k for k, o in enumerate(views.obs_ids)}
         table = self.dataset.triplets(split)
         triplets = np.array(
@@ -143,7 +151,7 @@ class _Harness:
 
         def batches(batch_size: int):  # noqa: ANN202
             loader = DataLoader(
-                ObservationDataset(self.data, split, transform=self.transform()),
+                ObservationDataset(self.dataset, split, transform=self.transform()),
                 batch_size=batch_size, collate_fn=collate_views,
             )  # fmt: skip
             return (batch for batch, _ in loader)
@@ -248,7 +256,8 @@ def _triplets(h: _Harness, e: _Embedded, split: str) -> tuple[np.ndarray, dict[s
 def _one_seed(
     name: str, factory: Callable[[], Any], data: Path, config: BenchmarkConfig, seed: int,
     work: Path, say: Callable[[str], None],
-) -> dict[str, Any]:  # fmt: skip
+) -> tuple[dict[str, Any], Any]:  # fmt: skip
+    """The protocol for one seed: its results, and the (fitted) method."""
     torch.manual_seed(seed)
     method = guarded(name, "its factory", factory)
     if not callable(getattr(method, "embed", None)):
@@ -305,7 +314,7 @@ def _one_seed(
             right, _ = _triplets(h, noisy, "test")
             result["box_noise"].append({**asdict(noise), "label": noise.label(),
                                         "accuracy": float(right.mean())})  # fmt: skip
-    return result
+    return result, method
 
 
 def breaking_point(by_bin: dict[str, dict[str, float]]) -> str | None:
@@ -371,20 +380,35 @@ def benchmark_method(
     config: BenchmarkConfig = BenchmarkConfig(),
     *,
     announce: Callable[[str], None] | None = None,
+    navigation: Callable[[Path], dict[str, Any]] | None = None,
 ) -> Path:
     """Run the protocol for one method and write its card under ``out``; the card's JSON path.
+
+    Args:
+        navigation: the navigation test of a method directory (the first seed's method, saved
+            in the card's directory), returning its summary for the card; the navigation stage
+            provides it (:func:`seannet.navigation.method_navigation.navigation_test`).
 
     Raises:
         MethodError: the method cannot be loaded or broke a check (no card is written).
     """
     from seannet.methods.cards import card_dir, write_card
+    from seannet.methods.localizer import save_method
 
     say = announce or (lambda _text: None)
     factory, _ = load_method(name)
     work = out / "runs"
-    runs = [_one_seed(name, factory, data, config, config.seeds[0], work, say)]
-    trained = runs[0]["trained"]  # a method with fit() trains once per seed
+    first, method = _one_seed(name, factory, data, config, config.seeds[0], work, say)
+    runs = [first]
+    trained = first["trained"]  # a method with fit() trains once per seed
     if trained:
-        runs += [_one_seed(name, factory, data, config, s, work, say) for s in config.seeds[1:]]
-    return write_card(card_dir(out, name), name, data, config, runs, summarize(runs),
-                      trained=trained)  # fmt: skip
+        runs += [_one_seed(name, factory, data, config, s, work, say)[0] for s in config.seeds[1:]]
+    summary = summarize(runs)
+    directory = card_dir(out, name)
+    directory.mkdir(parents=True, exist_ok=True)
+    save_method(directory, name, method, epsilon=first["threshold"]["epsilon"],
+                epsilon_source=f"val (benchmark, seed {first['seed']})", data=data)  # fmt: skip
+    if navigation is not None:
+        say(f"{name}: navigation test, seed {first['seed']}")
+        summary["navigation"] = navigation(directory)
+    return write_card(directory, name, data, config, runs, summary, trained=trained)

@@ -21,19 +21,24 @@ from seannet.markdown import pct, table
 from seannet.provenance import provenance_record, stamp
 from sgdata.fileio import atomic_write_text, save_png
 
-__all__ = ["CARD", "card_dir", "leaderboard", "read_cards", "write_card"]
+__all__ = ["CARD", "card_dir", "leaderboard", "method_label", "read_cards", "write_card"]
 
 CARD = "card.json"  # with card.md and sweep.png beside it
 _SAFE = re.compile(r"[^A-Za-z0-9_.+@-]+")
 
 
-def card_dir(out: Path, name: str) -> Path:
-    """Where the card of method ``name`` goes under ``out`` (an import path made a file name:
-    ``path/file.py:make`` -> ``file.py__make``)."""
+def method_label(name: str) -> str:
+    """Method ``name`` made a file name (an import path: ``path/file.py:make`` ->
+    ``file.py__make``): its card's directory, its maps' and navigation parts' label."""
     where, colon, attr = name.rpartition(":")
     if colon and where.endswith(".py"):
         name = f"{Path(where).name}:{attr}"
-    return out / _SAFE.sub("_", name.replace(":", "__")).strip("_")
+    return _SAFE.sub("_", name.replace(":", "__")).strip("_")
+
+
+def card_dir(out: Path, name: str) -> Path:
+    """Where the card of method ``name`` goes under ``out`` (:func:`method_label`)."""
+    return out / method_label(name)
 
 
 def _interval(entry: dict[str, float]) -> str:
@@ -84,7 +89,41 @@ def _markdown(card: dict[str, Any]) -> str:
         lines += table(
             ["noise", "accuracy"], [[n["label"], pct(n["accuracy"])] for n in s["box_noise"]]
         )
+    if "navigation" in s:
+        lines += _navigation_lines(s["navigation"])
     return "\n".join(lines) + "\n"
+
+
+def _navigation_lines(nav: dict[str, Any]) -> list[str]:
+    """The navigation test's rates per rule and case, % with the 95 % interval by rooms."""
+    lines = [
+        "",
+        f"Navigation test with this method as localizer ({nav['split']} rooms, "
+        f"{nav['episodes_per_case_and_room']} episodes per case and room, navigator "
+        f"`{Path(nav['navigator']).name}`, epsilon {nav['epsilon']:.3f} from val; % [95 % "
+        f"interval by rooms]; [{nav['results']}]({nav['results']})):",
+        "",
+    ]
+    rows = []
+    for rule, cases in nav["rates"].items():
+        for case, rates in cases.items():
+            outcomes = [k for k in rates if k != "episodes"]
+            rows.append([rule, case, str(rates["episodes"]),
+                         *(_rate(rates[k]) for k in outcomes)])  # fmt: skip
+    return lines + table(["rule", "case", "episodes", *outcomes], rows)
+
+
+def _rate(rate: dict[str, float]) -> str:
+    return f"{rate['percent']:.1f} [{rate['low']:.0f}, {rate['high']:.0f}]"
+
+
+def _navigation_cell(card: dict[str, Any]) -> str:
+    """Success % N / A under the paper's rule, or "-" without a navigation test."""
+    nav = card["summary"].get("navigation")
+    if not nav:
+        return "-"
+    paper = nav["rates"]["paper"]
+    return " / ".join(f"{paper[c]['success']['percent']:.1f}" for c in paper)
 
 
 def _plot(card: dict[str, Any]) -> Image.Image:
@@ -168,7 +207,8 @@ def leaderboard(cards: list[dict[str, Any]]) -> str:
         by_data.setdefault(card["provenance"].get("manifest_sha256", "?"), []).append(card)
     lines = ["# Leaderboard", ""]
     header = ["method", "seeds", "accuracy % (rooms x seeds, 95 %)", "recall@1 %", "recall@5 %",
-              "breaks at (moved objects)", "ms / view", "bytes / entry"]  # fmt: skip
+              "breaks at (moved objects)", "ms / view", "bytes / entry",
+              "navigation success % N / A"]  # fmt: skip
     for fingerprint, group in by_data.items():
         group.sort(key=lambda c: -c["summary"]["accuracy"]["mean"])
         rows = [
@@ -181,6 +221,7 @@ def leaderboard(cards: list[dict[str, Any]]) -> str:
                 c["summary"]["breaks_at"].get("moved_objects") or "never",
                 f"{c['summary']['ms_per_view']:.2f}",
                 str(c["summary"]["bytes_per_map_entry"]),
+                _navigation_cell(c),
             ]
             for c in group
         ]

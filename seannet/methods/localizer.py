@@ -1,10 +1,29 @@
-"""A method as a localizer: what maps, ``seannet localize`` and ``seannet navigate`` call to
-embed views and score them, with every output checked (the same checks as the benchmark)."""
+"""A method as a localizer: what maps, ``seannet map`` / ``localize`` / ``navigate`` call to
+embed views and score them, with every output checked (the same checks as the benchmark).
+
+A method reaches them three ways (:func:`open_method`):
+
+- by **name** (``tiny-image``, ``path/file.py:Make``, an entry point): a method with no
+  ``fit``; its threshold epsilon is given (``--epsilon``);
+- by a **method directory**: ``method.json`` (its name, the epsilon chosen on val and the
+  dataset it was fit on) and, for a trained method, ``method.pt`` (the fitted object).
+  ``seannet benchmark`` writes one into every card directory, so a card directory names any
+  benchmarked method, the trained ones included (:func:`save_method`);
+- a trained run directory (``best.pt``) is a bundled method too: :mod:`seannet.navigation`
+  opens it as before.
+
+A localizer's vectors are what the method's similarity reads (unit rows for cosine; the
+boxes too for a method that scores them), so a map holds what the method needs.
+"""
 
 from __future__ import annotations
 
+import hashlib
+import io
+import json
 import math
 from collections.abc import Sequence
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -12,14 +31,20 @@ import torch
 import torch.nn.functional as F
 
 from seannet.data.collate import ViewTensors, collate_views
+from seannet.data.opening import dataset_identity
 from seannet.data.view_inputs import ImageTransform
+from seannet.errors import MethodError
 from seannet.methods.checks import checked_similarity, checked_vectors, guarded
 from seannet.methods.registry import load_method
 from seannet.methods.views import Views
+from seannet.training.runs import MODEL_KEYS
+from sgdata.fileio import atomic_write_bytes, atomic_write_text
 
-__all__ = ["MethodLocalizer"]
+__all__ = ["METHOD_FILE", "STATE_FILE", "MethodLocalizer", "open_method", "save_method"]
 
 BATCH = 16  # views per embed() call
+METHOD_FILE = "method.json"  # name, epsilon and its source, dataset identity, trained
+STATE_FILE = "method.pt"  # a fitted method, pickled by torch.save
 
 
 class MethodLocalizer:
@@ -28,13 +53,31 @@ class MethodLocalizer:
     Built from a method name (:func:`~seannet.methods.registry.load_method`; a trained method
     must be fit first: pass the fitted object as ``method``). ``epsilon`` is the threshold a
     benchmark card chose on val (``card["summary"]["epsilon"]``), NaN when unknown.
+
+    The navigation side reads ``name``, ``source`` (what names it: the method's name or its
+    directory), ``digest`` (maps record it), ``identity`` (the dataset), ``epsilon``,
+    ``epsilon_source``, ``transform``, :meth:`embed` and :meth:`similarities`.
     """
 
-    def __init__(self, name: str, method: Any | None = None, *, epsilon: float = math.nan):
+    def __init__(
+        self,
+        name: str,
+        method: Any | None = None,
+        *,
+        epsilon: float = math.nan,
+        epsilon_source: str = "none",
+        identity: dict[str, Any] | None = None,
+        source: str | None = None,
+        digest: str | None = None,
+    ) -> None:
         self.name = name
         self.method = method if method is not None else guarded(name, "its factory",
                                                                 load_method(name)[0])  # fmt: skip
         self.epsilon = epsilon
+        self.epsilon_source = epsilon_source
+        self.identity = identity or {}
+        self.source = source or name
+        self.digest = digest or _name_digest(name)
         self._similarity = getattr(self.method, "similarity", None)
 
     @property
@@ -48,8 +91,10 @@ class MethodLocalizer:
         parts = []
         for start in range(0, len(views), BATCH):
             batch, _ = collate_views(list(views[start : start + BATCH]))
-            out = guarded(self.name, "embed", self.method.embed, Views(batch, method=self.name))
-            parts.append(checked_vectors(self.name, out, batch.num_views, None))
+            with torch.no_grad():
+                out = guarded(self.name, "embed", self.method.embed, Views(batch, method=self.name))
+            width = parts[0].shape[1] if parts else None
+            parts.append(checked_vectors(self.name, out, batch.num_views, width))
         if not parts:
             return np.zeros((0, 0), dtype=np.float32)
         vectors = torch.cat(parts)
@@ -65,4 +110,132 @@ class MethodLocalizer:
         )
         if self._similarity is None:
             return (ta * tb).sum(1).double().numpy()
-        return checked_similarity(self.name, self._similarity, ta, tb).numpy()
+        with torch.no_grad():
+            return checked_similarity(self.name, self._similarity, ta, tb).numpy()
+
+    def similarities(self, vector: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        """(N,) similarity of one vector of :meth:`embed` to each of ``rows`` (a map's)."""
+        if self._similarity is None:
+            return rows @ vector
+        return self.score(np.broadcast_to(vector, rows.shape), rows)
+
+
+def _name_digest(name: str) -> str:
+    """What an unfitted method's maps are keyed by: its name and, for a file, its bytes."""
+    digest = hashlib.sha256(name.encode())
+    where, colon, _ = name.rpartition(":")
+    if colon and where.endswith(".py") and Path(where).is_file():
+        digest.update(Path(where).read_bytes())
+    return digest.hexdigest()
+
+
+def save_method(
+    directory: Path,
+    name: str,
+    method: Any,
+    *,
+    epsilon: float,
+    epsilon_source: str,
+    data: Path,
+) -> Path:
+    """Write ``method.json`` (and, for a method with ``fit``, ``method.pt``: the fitted object)
+    into ``directory``, so that :func:`open_method` gives the same localizer back."""
+    trained = callable(getattr(method, "fit", None))
+    if trained:
+        buffer = io.BytesIO()
+        torch.save(method, buffer)
+        atomic_write_bytes(directory / STATE_FILE, buffer.getvalue())
+    record = {
+        "method": 1,
+        "name": name,
+        "trained": trained,
+        "epsilon": epsilon,
+        "epsilon_source": epsilon_source,
+        "dataset": dataset_identity(data),
+    }
+    atomic_write_text(directory / METHOD_FILE, json.dumps(record, indent=1))
+    return directory / METHOD_FILE
+
+
+def _read_record(path: Path) -> dict[str, Any]:
+    try:
+        record = json.loads(path.read_text())
+    except (OSError, ValueError) as exc:
+        raise MethodError(f"{path}: not a method record ({exc})") from None
+    if not isinstance(record, dict) or not isinstance(record.get("name"), str):
+        raise MethodError(f"{path}: no method name in it; write it again with seannet benchmark")
+    return record
+
+
+def open_method(
+    target: str | Path,
+    data: Path,
+    *,
+    epsilon: float | None = None,
+    source: str = "--epsilon",
+    require_epsilon: bool = True,
+) -> MethodLocalizer:
+    """The localizer ``target`` names on ``data``: a method directory (``method.json``) or a
+    method name of :func:`~seannet.methods.registry.load_method`.
+
+    Args:
+        epsilon: the threshold to use; None: the directory's (a name has none).
+        source: where a given ``epsilon`` comes from (reported beside it).
+        require_epsilon: without one, raise (True) or leave epsilon NaN (building maps).
+
+    Raises:
+        MethodError: no such method; a trained method named without its directory; a
+            directory fit on another dataset's vocabulary; no epsilon when one is required.
+    """
+    directory = Path(target)
+    identity = dataset_identity(data)
+    if (directory / METHOD_FILE).is_file():
+        record = _read_record(directory / METHOD_FILE)
+        name = record["name"]
+        factory, _ = load_method(name)  # imports the method's module (for the pickle too)
+        state = directory / STATE_FILE
+        if record.get("trained"):
+            if not state.is_file():
+                raise MethodError(f"{directory}: {STATE_FILE} is missing; benchmark it again")
+            fitted = record.get("dataset", {})
+            if any(fitted.get(k) != identity.get(k) for k in MODEL_KEYS):
+                raise MethodError(
+                    f"{directory}: method {name!r} was fit on another dataset's vocabulary "
+                    f"than {data}'s"
+                )
+            blob = state.read_bytes()
+            method = guarded(name, "loading its state", _load_state, blob)
+            digest = hashlib.sha256(blob).hexdigest()
+        else:
+            method, digest = guarded(name, "its factory", factory), _name_digest(name)
+        if epsilon is None:
+            found = record.get("epsilon")
+            if isinstance(found, int | float) and math.isfinite(found):
+                epsilon, source = float(found), f"{directory / METHOD_FILE}"
+        where = str(directory.resolve())
+    else:
+        name = str(target)
+        factory, _ = load_method(name)
+        method = guarded(name, "its factory", factory)
+        if callable(getattr(method, "fit", None)):
+            raise MethodError(
+                f"method {name!r} is trained (it has fit): run `seannet benchmark --methods "
+                f"{name}` and give its card directory instead"
+            )
+        digest, where = _name_digest(name), name
+    if epsilon is None:
+        if require_epsilon:
+            raise MethodError(
+                f"method {name!r}: no epsilon; pass --epsilon or give its card directory"
+            )
+        epsilon, source = math.nan, "none"
+    if require_epsilon and not math.isfinite(epsilon):
+        raise MethodError(f"epsilon {epsilon}: expected a finite number")
+    return MethodLocalizer(
+        name, method, epsilon=float(epsilon), epsilon_source=source, identity=identity,
+        source=where, digest=digest,
+    )  # fmt: skip
+
+
+def _load_state(blob: bytes) -> Any:
+    return torch.load(io.BytesIO(blob), map_location="cpu", weights_only=False)

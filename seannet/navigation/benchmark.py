@@ -1,12 +1,15 @@
-"""``seannet navigate``: the navigation benchmark (paper Table II) of localizer runs.
+"""``seannet navigate``: the navigation benchmark (paper Table II) of localizers.
 
-Every localizer run is tested on the same episodes: each is drawn from
+A localizer is a trained run, a method directory (every benchmark card's) or a method's
+name (:func:`seannet.navigation.localizer.open_localizer`); "run" below means any of them.
+Every localizer is tested on the same episodes: each is drawn from
 :func:`seannet.seeds.episode_seed` (test seed, room, case, index) and from the map's structure,
 which is the same whatever run embedded it. Maps are built once per run and room into
 ``<maps>/<run label>/<room>/`` and reused (:func:`seannet.navigation.maps.ensure_map`).
 
 A run's label is the shortest tail of its path that tells it from the other runs
-(``seed0``, or ``lr0.01_seed0`` next to ``lr0.003_seed0``).
+(``seed0``, or ``lr0.01_seed0`` next to ``lr0.003_seed0``); a method's name is its own label
+(made a file name).
 
 The work runs in spawned worker processes that die with their parent
 (:func:`sgdata.pipeline.executors.run_tasks`), one task per map, then one per (run, room,
@@ -35,9 +38,10 @@ from PIL import Image, ImageDraw, ImageFont
 from seannet.data.datasets import dataset_identity, open_dataset
 from seannet.data.live_views import LiveRooms
 from seannet.errors import NavigationError
+from seannet.methods.cards import method_label
 from seannet.navigation.config import MAP_SPACING, NavigationTestConfig
 from seannet.navigation.episodes import CASES, EpisodeResult, run_episode, sample_episode
-from seannet.navigation.localizer import Localizer, load_localizer
+from seannet.navigation.localizer import AnyLocalizer, open_localizer
 from seannet.navigation.maps import (
     MAP_META,
     check_map,
@@ -73,7 +77,7 @@ PARTS = "parts"
 
 
 def run_navigation(
-    runs: list[Path],
+    runs: list[Path | str],
     navigator: Path | None,
     data: Path,
     config: NavigationTestConfig | None = None,
@@ -89,6 +93,7 @@ def run_navigation(
     """Run the navigation test of every localizer run on the rooms of ``config.split``.
 
     Args:
+        runs: the localizers: run directories, method directories or method names.
         navigator: a ``train-navigator`` run; None for the oracle (:data:`ORACLE`).
         config: the test's settings (default :class:`NavigationTestConfig`'s); with
             ``replan`` every episode runs under bump and replan and its paper-rule outcome is
@@ -105,6 +110,7 @@ def run_navigation(
 
     Raises:
         CheckpointError: a run or the navigator was trained on another dataset.
+        MethodError: a method that cannot be opened or breaks a check.
         NavigationError: bad counts, no epsilon for a run, a split without rooms, a room
             without an episode, or no ``out`` for the oracle.
     """
@@ -115,12 +121,12 @@ def run_navigation(
     if out is None:
         raise NavigationError("the oracle navigator has no run directory: pass --out")
     maps = maps or out / "maps"
-    identity = dataset_identity(data)
+    ds = open_dataset(data)  # the manifest read once for the whole command
+    identity = dataset_identity(ds)
     if navigator is not None:
         state = load_checkpoint(navigator / BEST)
         check_same_dataset(navigator / BEST, state["dataset"], identity)
         load_navigator(navigator)  # refuses a localizer run given as the navigator, here
-    ds = open_dataset(data)
     rooms = list(ds.rooms(config.split)) if config.split in ds.splits else []
     if not rooms:
         raise NavigationError(f"{data}: split {config.split!r} has no room to navigate in")
@@ -133,10 +139,11 @@ def run_navigation(
         "dataset": identity,
     }
     labels = dict(zip(runs, run_labels(runs), strict=True))
-    _build_maps(localizers, data, rooms, {r: maps / labels[r] for r in runs}, config, workers, say)
+    named = dict(zip(runs, localizers, strict=True))
+    _build_maps(named, data, rooms, {r: maps / labels[r] for r in runs}, config, workers, say)
     jobs = {
-        (loc.run, room_id, case): _job(settings, loc, labels[loc.run], room_id, case, maps, strips)
-        for loc in localizers
+        (run, room_id, case): _job(settings, run, loc, labels[run], room_id, case, maps, strips)
+        for run, loc in named.items()
         for room_id in rooms
         for case in CASES
     }
@@ -144,14 +151,14 @@ def run_navigation(
     for done in run_tasks(_case_task, todo, workers=workers):
         say(f"{done['label']}: {done['room_id']} {done['case']} done")
     results: dict[str, Any] = {**settings, "config": dataclasses.asdict(config), "runs": []}
-    for loc in localizers:
+    for run, loc in named.items():
         records = [
             episode for room_id in rooms for case in CASES
-            for episode in _finished_part(jobs[loc.run, room_id, case], out)
+            for episode in _finished_part(jobs[run, room_id, case], out)
         ]  # fmt: skip
-        results["runs"].append(_run_entry(loc, labels[loc.run], records))
+        results["runs"].append(_run_entry(run, loc, labels[run], records))
     out.mkdir(parents=True, exist_ok=True)
-    append_provenance(out, data, step=results_path(out, config.split).stem)
+    append_provenance(out, ds, step=results_path(out, config.split).stem)
     write_results(results, results_path(out, config.split))
     written = results_path(out, config.split).with_suffix(".md")
     atomic_write_text(written, markdown(results))
@@ -182,20 +189,20 @@ def _config(config: NavigationTestConfig | None, settings: dict[str, Any]) -> Na
 
 
 def _build_maps(
-    localizers: list[Localizer],
+    localizers: dict[Path | str, AnyLocalizer],
     data: Path,
     rooms: list[str],
-    directories: dict[Path, Path],
+    directories: dict[Path | str, Path],
     config: NavigationTestConfig,
     workers: int,
     say: Callable[[str], None],
 ) -> None:
     """Build the maps of every run and room that are missing or stale (in workers)."""
     jobs = [
-        (loc.run, data, room_id, directories[loc.run] / room_id, config.spacing)
-        for loc in localizers
+        (str(run), data, room_id, directories[run] / room_id, config.spacing)
+        for run, loc in localizers.items()
         for room_id in rooms
-        if current_map(loc, room_id, directories[loc.run] / room_id, spacing=config.spacing) is None
+        if current_map(loc, room_id, directories[run] / room_id, spacing=config.spacing) is None
     ]
     for done in run_tasks(_map_task, jobs, workers=workers):
         say(f"map of {done['room_id']} by {done['run']}")
@@ -203,7 +210,8 @@ def _build_maps(
 
 def _job(
     settings: dict[str, Any],
-    loc: Localizer,
+    run: Path | str,
+    loc: AnyLocalizer,
     label: str,
     room_id: str,
     case: str,
@@ -213,7 +221,7 @@ def _job(
     """One task: the episodes of one (run, room, case); its key fields say what they depend on."""
     return {
         **settings,
-        "run": str(loc.run),
+        "run": str(run),
         "checkpoint_sha256": loc.digest,
         "epsilon": loc.epsilon,
         "room_id": room_id,
@@ -224,10 +232,12 @@ def _job(
     }
 
 
-def _run_entry(loc: Localizer, label: str, records: list[dict[str, Any]]) -> dict[str, Any]:
+def _run_entry(
+    run: Path | str, loc: AnyLocalizer, label: str, records: list[dict[str, Any]]
+) -> dict[str, Any]:
     """A run's entry of the results: what it is, its threshold, its episodes."""
     return {
-        "run": str(loc.run),
+        "run": str(run),
         "label": label,
         "model": loc.name,
         "epsilon": loc.epsilon,
@@ -271,25 +281,33 @@ def seed_maps(
 
 
 def _localizer(
-    run: Path, data: Path, epsilon: float | dict[Path, tuple[float, str]] | None
-) -> Localizer:
+    run: Path | str, data: Path, epsilon: float | dict[Path, tuple[float, str]] | None
+) -> AnyLocalizer:
     if isinstance(epsilon, dict):
-        given, source = epsilon.get(run, (None, ""))
-        return load_localizer(run, data, epsilon=given, source=source)
-    return load_localizer(run, data, epsilon=epsilon)
+        given, source = epsilon.get(run, (None, ""))  # type: ignore[call-overload]
+        return open_localizer(run, data, epsilon=given, source=source)
+    return open_localizer(run, data, epsilon=epsilon)
 
 
-def run_labels(runs: list[Path]) -> list[str]:
-    """The shortest tails of the runs' paths (parts joined by ``_``) that are all different.
+def _label_parts(run: Path | str) -> tuple[str, ...]:
+    """A path's (or a directory's) resolved parts; a method's name made one file name."""
+    if isinstance(run, Path) or Path(run).is_dir():
+        return Path(run).resolve().parts
+    return (method_label(str(run)),)
+
+
+def run_labels(runs: list[Path | str]) -> list[str]:
+    """The shortest tails of the runs' paths (parts joined by ``_``) that are all different;
+    a method's name (made a file name) is one part.
 
     Raises:
         NavigationError: a run given twice.
     """
-    paths = [run.resolve() for run in runs]
+    paths = [_label_parts(run) for run in runs]
     if len(set(paths)) < len(paths):
         raise NavigationError("a localizer run is given twice; give each once")
-    for k in range(1, max(len(p.parts) for p in paths) + 1):
-        labels = ["_".join(p.parts[-k:]).lstrip("/_") for p in paths]
+    for k in range(1, max(len(p) for p in paths) + 1):
+        labels = ["_".join(p[-k:]).lstrip("/_") for p in paths]
         if len(set(labels)) == len(labels):
             return labels
     raise NavigationError("localizer runs cannot be told apart by their paths")  # unreachable
@@ -329,10 +347,10 @@ def _one_thread() -> None:
     torch.set_num_threads(1)
 
 
-def _map_task(run: Path, data: Path, room_id: str, directory: Path, spacing: int) -> dict:
+def _map_task(run: str, data: Path, room_id: str, directory: Path, spacing: int) -> dict:
     """Build (or reuse) one room's map by one run (in a worker)."""
     _one_thread()
-    localizer = load_localizer(run, data, require_epsilon=False)
+    localizer = open_localizer(run, data, require_epsilon=False)
     with LiveRooms(data) as live:
         ensure_map(localizer, live, room_id, directory, spacing=spacing)
     return {"run": str(run), "room_id": room_id}
@@ -341,7 +359,7 @@ def _map_task(run: Path, data: Path, room_id: str, directory: Path, spacing: int
 def _case_task(job: dict[str, Any], data: str, out: str) -> dict:
     """Every episode of one (run, room, case), written as one part file (in a worker)."""
     _one_thread()
-    localizer: Localizer = load_localizer(Path(job["run"]), Path(data), epsilon=job["epsilon"])
+    localizer = open_localizer(job["run"], Path(data), epsilon=job["epsilon"])
     navigator = job["navigator"]
     policy = None if navigator == ORACLE else load_navigator(Path(navigator))
     directory = Path(job["map"])

@@ -37,7 +37,7 @@ import numpy as np
 from seannet.data.live_views import LiveRooms
 from seannet.errors import MapError, NavigationError
 from seannet.navigation.config import K_MAX
-from seannet.navigation.localizer import Localizer
+from seannet.navigation.localizer import AnyLocalizer
 from seannet.navigation.maps import TopoMap
 from seannet.navigation.motion import (
     HEADINGS,
@@ -337,7 +337,7 @@ def run_episode(
     episode: Episode,
     topo: TopoMap,
     live: LiveRooms,
-    localizer: Localizer,
+    localizer: AnyLocalizer,
     policy: Any,
     *,
     k_max: int = K_MAX,
@@ -389,7 +389,8 @@ def run_episode(
                 pose = nxt
                 current = clock.timed("render", live.view, *pose)
                 vector = clock.timed("embed", _embed, localizer, live, current)
-                steps.append(Step(action, pose, similarity=float(vector @ goal_vector)))
+                similarity = localizer.similarities(vector, goal_vector[None])[0]
+                steps.append(Step(action, pose, similarity=float(similarity)))
                 if keep_frames:
                     frames.append(current.rgb)
             verdict = step_verdict(steps[-1], b, localizer.epsilon)
@@ -402,7 +403,8 @@ def run_episode(
             avoid.add(frozenset((a[:2], b[:2])))
             if vector is None:  # bumped on the first move: the start view is not embedded yet
                 vector = clock.timed("embed", _embed, localizer, live, current)
-            here = topo.sub_nodes()[int(np.argmax(topo.embeddings @ vector))]
+            best = np.argmax(localizer.similarities(vector, topo.embeddings))
+            here = topo.sub_nodes()[int(best)]
             new = _replan(topo, here, plan[-1], avoid)
             if new is not None:
                 plan, n, replans = new, 0, replans + 1
@@ -421,7 +423,7 @@ def run_episode(
 
 
 def _ending(
-    segments: list[tuple[Pose, list[Step]]], outcome: str, failed: int, localizer: Localizer
+    segments: list[tuple[Pose, list[Step]]], outcome: str, failed: int, localizer: AnyLocalizer
 ) -> tuple[str, int, str | None]:
     """(outcome, failed segment, detail): a collision's cause or a localization failure's kind."""
     detail = None
@@ -432,7 +434,7 @@ def _ending(
     return outcome, failed, detail
 
 
-def _embed(localizer: Localizer, live: LiveRooms, view: Any) -> np.ndarray:
+def _embed(localizer: AnyLocalizer, live: LiveRooms, view: Any) -> np.ndarray:
     return localizer.embed([live.tensors(view, localizer.transform)])[0]
 
 

@@ -1,8 +1,14 @@
-"""A trained run as a localizer: its model, its image size and its threshold epsilon.
+"""The localizers maps and the navigation test use: a trained run (its model, image size and
+threshold epsilon), or any method (:class:`seannet.methods.MethodLocalizer`).
 
 The paper's localizer (§V-D, §VI-B) says "same place" when S(current, goal) > epsilon. A run's
 epsilon is the one ``seannet eval`` chose on the validation split (``eval_<split>.json``,
 ``threshold.epsilon``); ``--epsilon`` gives one where the run has not been evaluated.
+
+:func:`open_localizer` takes whatever names a localizer on the command line: a run directory
+(``best.pt``), a method directory (``method.json``: every benchmark card directory) or a
+method's name; each gives ``name``, ``source``, ``digest``, ``identity``, ``epsilon``,
+``epsilon_source``, ``transform``, ``embed(views)`` and ``similarities(vector, rows)``.
 """
 
 from __future__ import annotations
@@ -20,12 +26,13 @@ import torch
 from seannet.data.datasets import ImageTransform, ViewTensors, collate_views
 from seannet.errors import NavigationError
 from seannet.evaluation.run_eval import eval_file
+from seannet.methods.localizer import METHOD_FILE, MethodLocalizer, open_method
 from seannet.training.config import TrainConfig
 from seannet.training.loop import collect, embed_batch
 from seannet.training.runs import restore_run
 from sgdata.fileio import sha256_file
 
-__all__ = ["Localizer", "load_localizer", "run_epsilon"]
+__all__ = ["AnyLocalizer", "Localizer", "load_localizer", "open_localizer", "run_epsilon"]
 
 EVAL_SPLITS = ("val", "test")  # eval files searched for epsilon, in this order, then any other
 BATCH = 16  # views embedded per forward pass
@@ -44,6 +51,15 @@ class Localizer:
     identity: dict[str, Any]  # the dataset the run was trained on
     digest: str  # sha256 of the checkpoint: maps record it
     device: torch.device
+
+    @property
+    def source(self) -> str:
+        """What names this localizer: the run directory, resolved."""
+        return str(self.run.resolve())
+
+    def similarities(self, vector: np.ndarray, rows: np.ndarray) -> np.ndarray:
+        """(N,) cosine similarity of one unit vector of :meth:`embed` to each of ``rows``."""
+        return rows @ vector
 
     @property
     def transform(self) -> ImageTransform:
@@ -129,3 +145,33 @@ def load_localizer(
         digest=sha256_file(restored.path)[0],
         device=restored.device,
     )
+
+
+AnyLocalizer = Localizer | MethodLocalizer
+
+
+def open_localizer(
+    target: str | Path,
+    data: Path,
+    *,
+    epsilon: float | None = None,
+    source: str = "--epsilon",
+    require_epsilon: bool = True,
+) -> AnyLocalizer:
+    """The localizer ``target`` names: a method directory (``method.json``, e.g. a benchmark
+    card's) or a method name (:func:`seannet.methods.localizer.open_method`), else a run
+    directory (:func:`load_localizer`). Arguments as :func:`load_localizer`'s.
+
+    Raises:
+        CheckpointError, NavigationError: as :func:`load_localizer`, for a run.
+        MethodError: as :func:`~seannet.methods.localizer.open_method`, for a method.
+    """
+    path = Path(target)
+    text = str(target)
+    if not path.is_dir() and "/" in text and ":" not in text:
+        raise NavigationError(f"{text}: no such run or method directory")
+    if (path / METHOD_FILE).is_file() or not path.is_dir():
+        return open_method(target, data, epsilon=epsilon, source=source,
+                           require_epsilon=require_epsilon)  # fmt: skip
+    return load_localizer(path, data, epsilon=epsilon, source=source,
+                          require_epsilon=require_epsilon)  # fmt: skip

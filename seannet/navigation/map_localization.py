@@ -10,6 +10,9 @@ Two modes:
   it, overall and by the number of moved objects in view (0, 1-2, 3-5, 6+). An object is
   moved when its 3D box differs between the query's layout and the map's
   (:func:`seannet.data.moved.moved_instances`).
+
+S is the localizer's own similarity: cosine for a run, whatever the method's ``similarity``
+computes (its boxes included) for a method.
 """
 
 from __future__ import annotations
@@ -26,7 +29,7 @@ from seannet.data.live_views import layout_boxes
 from seannet.data.moved import BIN_NAMES, moved_bin, moved_instances
 from seannet.errors import DataError, MapError
 from seannet.evaluation.retrieval import recall_at_k
-from seannet.navigation.localizer import Localizer, load_localizer
+from seannet.navigation.localizer import AnyLocalizer, open_localizer
 from seannet.navigation.maps import TopoMap, check_map, load_map, map_dirs
 from seannet.training.runs import MODEL_KEYS
 from sgdata.dataset.paths import MANIFEST
@@ -37,14 +40,22 @@ __all__ = ["match", "localize_queries", "retrieval", "run_localize"]
 TOP = 5
 
 
-def match(topo: TopoMap, vector: np.ndarray, top: int = TOP) -> list[tuple[int, float]]:
-    """The ``top`` rows of ``topo`` most similar to a unit ``vector``: (row, S), best first."""
-    sims = topo.embeddings @ vector
+def match(
+    topo: TopoMap, vector: np.ndarray, top: int = TOP, localizer: AnyLocalizer | None = None
+) -> list[tuple[int, float]]:
+    """The ``top`` rows of ``topo`` most similar to ``vector`` by ``localizer``'s similarity
+    (None: cosine of unit vectors): (row, S), best first."""
+    sims = topo.embeddings @ vector if localizer is None else _sims(localizer, topo, vector)
     order = np.argsort(-sims, kind="stable")[:top]
     return [(int(k), float(sims[k])) for k in order]
 
 
-def _open_maps(localizer: Localizer, paths: list[Path]) -> list[TopoMap]:
+def _sims(localizer: AnyLocalizer, topo: TopoMap, vector: np.ndarray) -> np.ndarray:
+    """(N,) similarity of ``vector`` to every row of ``topo`` by the localizer's measure."""
+    return np.asarray(localizer.similarities(vector, topo.embeddings), dtype=np.float64)
+
+
+def _open_maps(localizer: AnyLocalizer, paths: list[Path]) -> list[TopoMap]:
     maps = []
     for path in paths:
         topo = load_map(path)
@@ -53,7 +64,7 @@ def _open_maps(localizer: Localizer, paths: list[Path]) -> list[TopoMap]:
     return maps
 
 
-def _find_views(data: Path, obs_ids: list[str], localizer: Localizer) -> dict[str, Any]:
+def _find_views(data: Path, obs_ids: list[str], localizer: AnyLocalizer) -> dict[str, Any]:
     """obs id -> ObservationItem, searching every split of ``data``.
 
     Raises:
@@ -62,7 +73,7 @@ def _find_views(data: Path, obs_ids: list[str], localizer: Localizer) -> dict[st
     ds = open_dataset(data)
     found: dict[str, Any] = {}
     for split in ds.splits:
-        views = ObservationDataset(data, split, transform=localizer.transform)
+        views = ObservationDataset(ds, split, transform=localizer.transform)
         index = {o: k for k, o in enumerate(views.obs_ids)}
         for o in obs_ids:
             if o in index and o not in found:
@@ -73,19 +84,19 @@ def _find_views(data: Path, obs_ids: list[str], localizer: Localizer) -> dict[st
     return found
 
 
-def _check_query_data(localizer: Localizer, data: Path) -> None:
+def _check_query_data(localizer: AnyLocalizer, data: Path) -> None:
     """A query dataset must share the run's vocabulary (a photo dataset is another dataset)."""
     current = dataset_identity(data)
     for key in MODEL_KEYS:
         if current.get(key) != localizer.identity.get(key):
             raise DataError(
-                f"{data}/dataset.json: {key} differs from the dataset {localizer.run} was "
+                f"{data}/dataset.json: {key} differs from the dataset {localizer.source} was "
                 f"trained on; queries need the same class vocabulary"
             )
 
 
 def localize_queries(
-    localizer: Localizer, maps: list[TopoMap], data: Path, queries: list[str], *, top: int = TOP
+    localizer: AnyLocalizer, maps: list[TopoMap], data: Path, queries: list[str], *, top: int = TOP
 ) -> list[dict[str, Any]]:
     """The best ``top`` sub-nodes for each query (see the module doc)."""
     _check_query_data(localizer, data)
@@ -94,7 +105,7 @@ def localize_queries(
     out = []
     for q, vector in zip(queries, vectors, strict=True):
         own = [m for m in maps if m.room_id == items[q].room_id] or maps
-        scored = [(m, k, s) for m in own for k, s in match(m, vector, top)]
+        scored = [(m, k, s) for m in own for k, s in match(m, vector, top, localizer)]
         scored.sort(key=lambda t: -t[2])
         out.append(
             {
@@ -115,16 +126,19 @@ def localize_queries(
     return out
 
 
-def retrieval(localizer: Localizer, maps: list[TopoMap], data: Path, split: str) -> dict[str, Any]:
+def retrieval(
+    localizer: AnyLocalizer, maps: list[TopoMap], data: Path, split: str
+) -> dict[str, Any]:
     """Recall@1 / @5 of the true sub-node for the split's views in other layouts.
 
     Raises:
         MapError: no map is of a room of ``split``.
     """
-    views = ObservationDataset(data, split, transform=localizer.transform)
+    ds = open_dataset(data)
+    views = ObservationDataset(ds, split, transform=localizer.transform)
     position = {o: k for k, o in enumerate(views.obs_ids)}
     columns = ["obs_id", "room_id", "layout", "grid_i", "grid_j", "heading", "objects"]
-    meta = open_dataset(data).observations(split, columns=columns).to_pylist()
+    meta = ds.observations(split, columns=columns).to_pylist()
     rooms = {m.room_id: m for m in maps}
     if not rooms.keys() & {r["room_id"] for r in meta}:
         raise MapError(f"no map is of a room of split {split!r}; build them with `seannet map`")
@@ -148,14 +162,15 @@ def retrieval(localizer: Localizer, maps: list[TopoMap], data: Path, split: str)
                 boxes[q["layout"]] = layout_boxes(data, room_id, q["layout"])
             moved = moved_instances(boxes[topo.layout], boxes[q["layout"]])
             true_row = topo.index((q["grid_i"], q["grid_j"], q["heading"]))
-            recall = recall_at_k((topo.embeddings @ vector)[None], np.array([true_row]), (1, 5))
+            sims = _sims(localizer, topo, vector)
+            recall = recall_at_k(sims[None], np.array([true_row]), (1, 5))
             rows.append(
                 {
                     "query": q["obs_id"],
                     "moved_in_view": len(moved & {o["instance"] for o in q["objects"]}),
                     "rank1": bool(recall[1]),
                     "rank5": bool(recall[5]),
-                    "true_similarity": float(topo.embeddings[true_row] @ vector),
+                    "true_similarity": float(sims[true_row]),
                 }
             )
     return _summarise(rows, localizer.epsilon, split)
@@ -178,7 +193,7 @@ def _summarise(rows: list[dict[str, Any]], epsilon: float, split: str) -> dict[s
 
 
 def run_localize(
-    run: Path,
+    run: Path | str,
     map_path: Path,
     data: Path,
     *,
@@ -191,21 +206,25 @@ def run_localize(
     """``seannet localize``: queries mode (``queries``) or split mode (``split``).
 
     Writes ``localize.json`` / ``.md`` (queries) or ``localize_<split>.json`` / ``.md`` into
-    ``out`` (default: the run directory).
+    ``out`` (default: the run or method directory). ``run`` names the localizer
+    (:func:`~seannet.navigation.localizer.open_localizer`: a run directory, a method directory
+    such as a benchmark card's, or a method's name).
 
     Raises:
-        MapError: no map, or a map another run or dataset built.
-        NavigationError: no epsilon.
+        MapError: no map, or a map another run, method or dataset built.
+        NavigationError, MethodError: no epsilon.
         DataError: an unknown query id, or a query dataset with another vocabulary.
     """
     if (queries is None) == (split is None):
         raise DataError("localize: give query ids or --split, not both and not neither")
+    if out is None and not Path(run).is_dir():
+        raise DataError(f"localize: {run} is a method's name, not a directory: pass --out")
     paths = map_dirs(map_path)
     first = load_map(paths[0])
     source = Path(str(first.meta.get("data", "")))
     if not (source / MANIFEST).is_file():
         raise MapError(f"{paths[0]}/map.json: data {str(source)!r} is not a dataset any more")
-    localizer = load_localizer(run, source, epsilon=epsilon)
+    localizer = open_localizer(run, source, epsilon=epsilon)
     maps = _open_maps(localizer, paths)
     head = {
         "run": str(run),
@@ -221,7 +240,7 @@ def run_localize(
         assert split is not None
         result = {**head, **retrieval(localizer, maps, data, split)}
         name, text = f"localize_{split}", _retrieval_markdown(result)
-    out = out or run
+    out = out or Path(run)
     atomic_write_text(out / f"{name}.json", json.dumps(result, indent=2))
     atomic_write_text(out / f"{name}.md", text)
     result["written"] = str(out / f"{name}.md")

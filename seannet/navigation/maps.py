@@ -3,7 +3,8 @@
 A map covers one layout of one room. Its nodes are the cells of the layout's reachable grid
 whose indices are multiples of ``spacing`` (1: every cell; the authors used 2); each node has
 four heading sub-nodes ``(i, j, h)``, each holding its observation id, its image and its
-embedding by one trained run. Edges (networkx, undirected):
+vector by one localizer (a trained run or any method: what the method's similarity reads,
+boxes included for a method that scores them). Edges (networkx, undirected):
 
 - **translation** between the same heading of two neighbouring nodes (``spacing`` cells apart
   along i or j, every cell on the way reachable), cost the Manhattan distance in cells;
@@ -14,8 +15,9 @@ Every sub-node is rendered live from the room's scene files
 so a map has no holes even though a dataset holds only the views its triplets referenced.
 
 On disk, a map directory holds ``map.parquet`` (one row per sub-node: obs_id, i, j, heading,
-embedding, image) and ``map.json`` (graph parameters and edges, the run's checkpoint digest and
-the dataset's identity); both are written atomically, so a map is built once and reused.
+embedding, image) and ``map.json`` (graph parameters and edges, the localizer's digest: a
+run's checkpoint sha256 or a method's, and the dataset's identity); both are written
+atomically, so a map is built once and reused.
 """
 
 from __future__ import annotations
@@ -35,7 +37,7 @@ import pyarrow.parquet as pq
 from seannet.data.live_views import LiveRooms
 from seannet.errors import MapError
 from seannet.navigation.config import MAP_SPACING
-from seannet.navigation.localizer import Localizer
+from seannet.navigation.localizer import AnyLocalizer
 from seannet.navigation.motion import HEADINGS
 from sgdata.dataset import decode_image
 from sgdata.dataset.paths import obs_id
@@ -103,7 +105,7 @@ class TopoMap:
     j: np.ndarray  # (N,) int
     heading: np.ndarray  # (N,) int
     obs_ids: list[str]
-    embeddings: np.ndarray  # (N, D) float32, unit rows
+    embeddings: np.ndarray  # (N, D) float32: the localizer's vectors (unit rows for cosine)
     images: list[bytes]  # encoded in the dataset's image format
     _graph: nx.Graph | None = field(default=None, repr=False)
     _index: dict[SubNode, int] | None = field(default=None, repr=False)
@@ -200,7 +202,7 @@ class TopoMap:
 
 
 def build_map(
-    localizer: Localizer,
+    localizer: AnyLocalizer,
     live: LiveRooms,
     room_id: str,
     *,
@@ -239,7 +241,7 @@ def build_map(
         "nodes": len(nodes),
         "sub_nodes": len(keys),
         "image_format": fmt,
-        "run": str(localizer.run.resolve()),
+        "run": localizer.source,
         "model": localizer.name,
         "checkpoint_sha256": localizer.digest,
         "embed_dim": int(embeddings.shape[1]),
@@ -349,8 +351,8 @@ def load_map(directory: Path) -> TopoMap:
         raise MapError(f"{table_path}: unreadable map table ({exc})") from None
 
 
-def check_map(topo: TopoMap, localizer: Localizer, where: Path) -> None:
-    """Refuse a map whose embeddings another checkpoint or dataset made.
+def check_map(topo: TopoMap, localizer: AnyLocalizer, where: Path) -> None:
+    """Refuse a map whose vectors another checkpoint, method or dataset made.
 
     Raises:
         MapError: naming ``map.json`` and the field that differs.
@@ -358,15 +360,15 @@ def check_map(topo: TopoMap, localizer: Localizer, where: Path) -> None:
     path = where / MAP_META
     if topo.meta["checkpoint_sha256"] != localizer.digest:
         raise MapError(
-            f"{path}: checkpoint_sha256 differs from {localizer.run}/best.pt; the map was built "
-            f"by another run (rebuild it with `seannet map {localizer.run}`)"
+            f"{path}: checkpoint_sha256 differs from {localizer.source}'s; the map was built "
+            f"by another run or method (rebuild it with `seannet map {localizer.source}`)"
         )
     if topo.meta["dataset"] != localizer.identity:
-        raise MapError(f"{path}: dataset differs from the run's; use the map's dataset")
+        raise MapError(f"{path}: dataset differs from the localizer's; use the map's dataset")
 
 
 def current_map(
-    localizer: Localizer,
+    localizer: AnyLocalizer,
     room_id: str,
     directory: Path,
     *,
@@ -386,7 +388,7 @@ def current_map(
 
 
 def ensure_map(
-    localizer: Localizer,
+    localizer: AnyLocalizer,
     live: LiveRooms,
     room_id: str,
     directory: Path,
@@ -419,7 +421,7 @@ def map_dirs(path: Path) -> list[Path]:
 
 
 def build_maps(
-    localizer: Localizer,
+    localizer: AnyLocalizer,
     data: Path,
     rooms: list[str],
     out: Path,
