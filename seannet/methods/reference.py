@@ -7,6 +7,9 @@
   (the ``lite`` extra).
 - ``lite0-gem-head``: the same descriptor with a linear head (1280 -> 256) trained on the
   train triplets with the triplet loss (the classical VPR recipe; lr chosen on val).
+- ``lite0-netvlad``: the frozen Lite0 map (1280 channels) reduced to 64 by a 1 x 1 conv and
+  pooled by NetVLAD (Arandjelović et al., https://arxiv.org/abs/1511.07247) with 16 clusters
+  (1,024-d), both trained on the train triplets the same way.
 - ``boxes-overlap``: the visible objects' boxes slot by slot, scored by their mean IoU.
 - ``boxes-kernel``: the same boxes, scored by a slot kernel learned on the train triplets.
 """
@@ -24,7 +27,15 @@ from seannet.methods.views import Budget, SplitData, Views
 from seannet.model.loss import TripletLoss
 from seannet.weights import LITE0, LITE0_WEIGHTS
 
-__all__ = ["BoxKernelMethod", "BoxOverlap", "Lite0GeM", "Lite0GeMHead", "TinyImage"]
+__all__ = [
+    "BoxKernelMethod",
+    "BoxOverlap",
+    "Lite0GeM",
+    "Lite0GeMHead",
+    "Lite0NetVLAD",
+    "NetVLAD",
+    "TinyImage",
+]
 
 
 @register_method("tiny-image")
@@ -54,8 +65,13 @@ class Lite0GeM:
         self.trunk = nn.Sequential(split.backbone, split.head[0]).eval()
 
     @torch.no_grad()
+    def features(self, views: Views) -> Tensor:
+        """(N, 1280, h, w) the frozen stride-32 map."""
+        return self.trunk(views.normalised)
+
+    @torch.no_grad()
     def embed(self, views: Views) -> Tensor:
-        features = self.trunk(views.normalised).clamp_min(1e-6)
+        features = self.features(views).clamp_min(1e-6)
         return features.pow(self.p).mean(dim=(2, 3)).pow(1.0 / self.p)
 
 
@@ -75,7 +91,11 @@ class Lite0GeMHead(Lite0GeM):
         self.choices: dict[str, object] = {}
 
     def _pooled(self, split: SplitData) -> Tensor:
+        """The frozen inputs of the head, every view of ``split`` in order."""
         return F.normalize(torch.cat([Lite0GeM.embed(self, v) for v in split.views()]), dim=1)
+
+    def _new_head(self, inputs: Tensor) -> nn.Module:
+        return nn.Linear(inputs.shape[1], self.dim)
 
     def _accuracy(self, head: nn.Module, features: Tensor, triplets: Tensor) -> float:
         with torch.no_grad():
@@ -90,7 +110,7 @@ class Lite0GeMHead(Lite0GeM):
         for lr in budget.lrs or (0.01, 0.1):
             order = torch.Generator().manual_seed(budget.seed)
             torch.manual_seed(budget.seed)
-            head = nn.Linear(train_x.shape[1], self.dim)
+            head = self._new_head(train_x)
             optimizer = torch.optim.SGD(head.parameters(), lr=lr, momentum=0.9)
             for _ in range(budget.epochs or self.epochs):
                 for rows in torch.randperm(len(train_t), generator=order).split(self.batch):
@@ -109,6 +129,46 @@ class Lite0GeMHead(Lite0GeM):
     @torch.no_grad()
     def embed(self, views: Views) -> Tensor:
         return F.normalize(self.head(F.normalize(super().embed(views), dim=1)), dim=1)
+
+
+class NetVLAD(nn.Module):
+    """NetVLAD pooling (Arandjelović et al. 2016) after a 1 x 1 channel reduction: soft
+    assignment of each location to ``clusters`` centroids, residuals summed per cluster,
+    intra-normalised, flattened and L2-normalised (``clusters`` x ``reduced`` wide)."""
+
+    def __init__(self, channels: int, clusters: int = 16, reduced: int = 64) -> None:
+        super().__init__()
+        self.reduce = nn.Conv2d(channels, reduced, kernel_size=1)
+        self.assign = nn.Conv2d(reduced, clusters, kernel_size=1)
+        self.centroids = nn.Parameter(0.1 * torch.randn(clusters, reduced))
+
+    def forward(self, maps: Tensor) -> Tensor:
+        x = F.normalize(self.reduce(maps), dim=1)
+        weights = F.softmax(self.assign(x), dim=1).flatten(2)  # (N, K, L)
+        x = x.flatten(2)  # (N, D, L)
+        residual = torch.einsum("nkl,ndl->nkd", weights, x)
+        residual = residual - weights.sum(2).unsqueeze(2) * self.centroids.unsqueeze(0)
+        return F.normalize(F.normalize(residual, dim=2).flatten(1), dim=1)
+
+
+@register_method("lite0-netvlad")
+class Lite0NetVLAD(Lite0GeMHead):
+    """Frozen Lite0, then NetVLAD (64 channels, 16 clusters: 1,024-d) trained on the train
+    triplets like ``lite0-gem-head``'s head (triplet loss, the lr of ``budget.lrs`` best on val).
+    The frozen maps of the train and val views are kept in memory while it trains."""
+
+    clusters = 16
+    reduced = 64
+
+    def _pooled(self, split: SplitData) -> Tensor:
+        return torch.cat([self.features(v) for v in split.views()])
+
+    def _new_head(self, inputs: Tensor) -> nn.Module:
+        return NetVLAD(inputs.shape[1], self.clusters, self.reduced)
+
+    @torch.no_grad()
+    def embed(self, views: Views) -> Tensor:
+        return self.head(self.features(views))
 
 
 @register_method("boxes-overlap")
