@@ -10,8 +10,10 @@ by torch's threads, used before, gave SeanNet 9 batches per epoch beside another
 on a quiet machine). The same few batches are trained in several rounds; a step's cost is the
 mean over the batches of each one's fastest round, and how far the rounds disagree (the
 spread) is recorded, and ``compare`` warns when it is high. What load still does: a busy core
-slows a thread through its caches even on the thread's own clock; beside two busy loops on
-the two cores of the docs' machine the cost came out 3 to 12 % higher (the old clock: 3x).
+slows a thread through its caches even on the thread's own clock: beside two busy loops on
+the two cores of the docs' machine the batches came out within 4 % of quiet when nothing else
+ran, and 5 to 16 % fewer when several other jobs already shared the cores (the old clock:
+a third to a quarter).
 On a GPU the steps are timed on the wall clock (after a synchronise): the GPU is the load.
 
 The seconds are one thread's, whatever threads the run itself will use: a run on two cores
