@@ -16,6 +16,8 @@ _EXPORTS = {
     "BenchmarkConfig": ".benchmark",
     "benchmark_method": ".benchmark",
     "MethodLocalizer": ".localizer",
+    "open_method": ".localizer",
+    "save_method": ".localizer",
     "leaderboard": ".cards",
     "read_cards": ".cards",
 }
