@@ -3,7 +3,8 @@ the catalog loader and the shape every stage draws (:mod:`sgdata.world.mesh_asse
 
 Broken as users' files are: an empty mesh, NaN vertices, faces without area, a mesh in other
 units (up to a kilometre), a missing texture, an unknown format, random bytes, a glob that
-matches nothing, and wrong ``units`` / ``up`` / ``scale`` declarations.
+matches nothing, and wrong ``units`` / ``up`` / ``scale`` declarations; USD files (``.usda``,
+read with pxr) broken the same ways.
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ from .harness import Surface
 
 assets = st.fixed_dictionaries(
     {
-        "format": st.sampled_from(["obj", "stl", "ply", "glb", "fbx", "obj"]),
+        "format": st.sampled_from(["obj", "stl", "ply", "glb", "fbx", "obj", "usda"]),
         "scale": st.sampled_from([1.0, 100.0, 1000.0, 1e6, 1e-4, 0.5, 4.0]),
         "nan": st.sampled_from([0, 0, 0, 0, 1, 3]),
         "flat": st.sampled_from([0, 0, 0, 1, 2, 40]),  # faces collapsed to a point
@@ -69,6 +70,9 @@ def _write(example: dict[str, Any], folder: Path) -> str:
 
             Image.new("RGB", (2, 2), (90, 60, 30)).save(folder / "wood.png")
         return name
+    if example["format"] == "usda":
+        _write_usd(folder / name, vertices, faces, example["up"])
+        return name
     if example["format"] == "fbx":
         (folder / name).write_bytes(b"Kaydara FBX Binary  \x00")
         return name
@@ -77,7 +81,24 @@ def _write(example: dict[str, Any], folder: Path) -> str:
     return name
 
 
+def _write_usd(path: Path, vertices: np.ndarray, faces: np.ndarray, up: str | None) -> None:
+    """A USD stage holding one mesh (NaN points and empty faces as given)."""
+    from pxr import Usd, UsdGeom, Vt
+
+    stage = Usd.Stage.CreateInMemory()
+    if up is not None:
+        UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y if up == "y" else UsdGeom.Tokens.z)
+    mesh = UsdGeom.Mesh.Define(stage, "/Thing")
+    mesh.CreatePointsAttr(Vt.Vec3fArray.FromNumpy(np.asarray(vertices, np.float32)))
+    mesh.CreateFaceVertexCountsAttr(Vt.IntArray.FromNumpy(np.full(len(faces), 3, np.int32)))
+    mesh.CreateFaceVertexIndicesAttr(Vt.IntArray.FromNumpy(np.asarray(faces, np.int32).ravel()))
+    path.write_text(stage.GetRootLayer().ExportToString(), encoding="utf-8")
+
+
 def feed(example: dict[str, Any], work: Path, session: None) -> None:
+    from sgdata.usd.mesh_files import register_usd_mesh_reader
+
+    register_usd_mesh_reader()  # as the run's catalog does
     name = _write(example, work / "meshes")
     pattern = "meshes/none-*.obj" if example["glob_nothing"] else f"meshes/{name}"
     lines = ["[classes.Plate]", f'mesh = "{pattern}"']
