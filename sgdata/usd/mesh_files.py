@@ -102,6 +102,8 @@ def _read(stage: Usd.Stage, file: Path) -> RawMesh:
         images=tuple(images.values()),
         up=up,
         meters_per_unit=meters,
+        # files on disk (not inside a USDZ package, whose sha256 covers them)
+        texture_paths=tuple(sorted(str(Path(p).resolve()) for p in pixels if "[" not in p)),
     )
 
 

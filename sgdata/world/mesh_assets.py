@@ -166,6 +166,7 @@ def _read_cached(
         )
     textures = texture_files(file)
     raw = read_mesh_file(file)
+    textures = sorted({*textures, *(Path(p) for p in raw.texture_paths)})
     vertices, keep = _checked(file, raw.vertices, raw.faces)
     faces = raw.faces[keep].astype(np.int32)
     source = _declared(raw, source)

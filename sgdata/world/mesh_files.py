@@ -61,6 +61,7 @@ class RawMesh:
     images: tuple[MeshImage, ...] = ()
     up: str | None = None  # the up axis the file declares ("y" | "z"), None: not declared
     meters_per_unit: float | None = None  # the unit the file declares, None: not declared
+    texture_paths: tuple[str, ...] = ()  # image files read beside it (hashed for provenance)
 
 
 Reader = Callable[[Path], RawMesh]

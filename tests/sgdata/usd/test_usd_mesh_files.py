@@ -116,6 +116,14 @@ def test_usdz_textures_are_read_from_the_package(tmp_path: Path) -> None:
     assert np.round(asset.face_colors[0] * 255).tolist() == [10, 200, 30]
 
 
+def test_a_texture_beside_the_stage_is_hashed(tmp_path: Path) -> None:
+    Image.fromarray(np.full((2, 2, 3), 90, np.uint8)).save(tmp_path / "grey.png")
+    _write_plate(tmp_path / "plate.usda", up="z", meters=1.0, texture="grey.png")
+    (asset,) = class_assets(_plate_class(tmp_path, "plate.usda"))
+    assert [Path(t).name for t in asset.textures] == ["grey.png"]
+    assert len(asset.texture_sha256) == 1  # in the manifest, checked by validate --sources
+
+
 def test_a_missing_texture_is_one_line(tmp_path: Path) -> None:
     _write_plate(tmp_path / "plate.usda", up="z", meters=1.0, texture="gone.png")
     with pytest.raises(CatalogError) as info:
