@@ -7,6 +7,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from seannet.errors import ModelError
+from seannet.model.specs import ABLATION_FIELDS
 from seannet.weights import NETWORKS
 
 __all__ = ["BACKBONES", "MODEL_FIELDS", "ModelConfig", "VISUAL_FEATURES"]
@@ -47,6 +48,7 @@ class ModelConfig:
     dropout: float = 0.2  # on the GCN layers (paper §V-B)
 
     def __post_init__(self) -> None:
+        self._apply_ablation_fields()
         for name in ("depth", "image_size", "roi_size", "embed_dim", "graph_hidden"):
             if getattr(self, name) < 1:
                 raise ModelError(f"model.{name} must be >= 1, got {getattr(self, name)}")
@@ -77,9 +79,31 @@ class ModelConfig:
         record = NETWORKS.get(self.name)
         return record.family if record is not None else self.backbone
 
+    def _apply_ablation_fields(self) -> None:
+        """An ablation of :data:`~seannet.model.specs.ABLATION_FIELDS` sets its fields: a
+        field at the default takes the ablation's value (configs saved before 2026-12-03 named
+        ``seannet-fc512`` with ``graph_hidden`` 4096 and built 512), another value is refused."""
+        for field, value in ABLATION_FIELDS.get(self.name, {}).items():
+            given = getattr(self, field)
+            if given == value:
+                continue
+            if given != _DEFAULTS[field]:
+                raise ModelError(
+                    f"model {self.name!r} has {field} {value}, got {given}: name "
+                    f"{self.name!r} alone, or another model with {field} {given}"
+                )
+            object.__setattr__(self, field, value)  # frozen: set once, while constructing
+
     def replace(self, **changes: Any) -> ModelConfig:
-        """A copy with some fields changed (validated again)."""
+        """A copy with some fields changed (validated again). Changing the name away from an
+        ablation of :data:`~seannet.model.specs.ABLATION_FIELDS` resets the fields it set
+        (``seannet-fc512`` -> ``seannet`` is the 4,096-wide fc again) unless given."""
+        name = changes.get("name", self.name)
+        if name != self.name:
+            for field in ABLATION_FIELDS.get(self.name, {}):
+                changes.setdefault(field, _DEFAULTS[field])
         return dataclasses.replace(self, **changes)
 
 
 MODEL_FIELDS = frozenset(f.name for f in dataclasses.fields(ModelConfig))
+_DEFAULTS = {f.name: f.default for f in dataclasses.fields(ModelConfig)}

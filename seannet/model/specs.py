@@ -16,6 +16,7 @@ from seannet.weights import IMAGE_ENCODERS, NETWORKS
 
 __all__ = [
     "ABLATIONS",
+    "ABLATION_FIELDS",
     "IMAGENET",
     "MODEL_NAMES",
     "SCENE_TERMS",
@@ -35,8 +36,13 @@ ABLATIONS: dict[str, dict[str, Any]] = {
     "seannet-novisual": {"object_inputs": ("box", "word")},
     "seannet-nobox": {"object_inputs": ("visual", "word")},
     "seannet-nolayout": {"layout_grid": 0},  # the paper's graph branch: GCN pathways only
+    "seannet-fc512": {},  # its GCN fc width is a config field: ABLATION_FIELDS
+}
+# ablations that are a ModelConfig field set to another value: the config holds the value
+# (ModelConfig applies it), so the config a run saves is the model it built
+ABLATION_FIELDS: dict[str, dict[str, Any]] = {
     # a 512-wide GCN fc instead of the paper's 4,096: a CPU step near ResNet-18's
-    "seannet-fc512": {"graph_hidden_dim": 512},
+    "seannet-fc512": {"graph_hidden": 512},
 }
 MODEL_NAMES = (SEANNET, *ABLATIONS, *IMAGE_ENCODERS)
 IMAGENET = "+imagenet"

@@ -10,7 +10,14 @@ import pytest
 
 from seannet.errors import ModelError
 from seannet.model.config import BACKBONES, ModelConfig
-from seannet.model.specs import ABLATIONS, MODEL_NAMES, SCENE_TERMS, parse_spec, spec_help
+from seannet.model.specs import (
+    ABLATION_FIELDS,
+    ABLATIONS,
+    MODEL_NAMES,
+    SCENE_TERMS,
+    parse_spec,
+    spec_help,
+)
 from seannet.weights import IMAGE_ENCODERS, LITE0, LITE0_WEIGHTS, NETWORKS, network, network_table
 
 
@@ -96,3 +103,25 @@ def test_the_docs_table_is_the_registry() -> None:
 
     docs = (Path(__file__).parents[3] / "docs" / "training.md").read_text()
     assert network_table() in docs, "docs/training.md: paste `seannet networks` again"
+
+
+def test_an_ablation_of_a_config_field_stores_the_model_it_builds() -> None:
+    """seannet-fc512's config says 512, the width of the model built from it, the width saved in
+    a checkpoint and read back; an old config that said 4,096 is read as what it built."""
+    from seannet.model.factory import build_model
+    from seannet.training.config import TrainConfig, preset
+
+    assert ABLATION_FIELDS["seannet-fc512"] == {"graph_hidden": 512}
+    config = preset("cpu").replace(embed_dim=64)
+    assert config.model.name == "seannet-fc512" and config.model.graph_hidden == 512
+    model = build_model(config.model, num_slots=16)
+    assert model.gcn.fc[0].out_features == config.model.graph_hidden
+    saved = config.to_dict()
+    assert saved["model"]["graph_hidden"] == 512
+    assert TrainConfig.from_dict(saved).model == config.model
+    saved["model"]["graph_hidden"] = 4096  # what configs saved before 2026-12-03 said
+    assert TrainConfig.from_dict(saved).model.graph_hidden == 512
+    # naming the paper's SeanNet gives its fc back; a width the ablation contradicts is refused
+    assert config.replace(model="seannet").model.graph_hidden == 4096
+    with pytest.raises(ModelError, match="seannet-fc512.*graph_hidden 512, got 1024"):
+        ModelConfig(name="seannet-fc512", graph_hidden=1024)
