@@ -4,6 +4,7 @@ Real files in tmp_path; views are built by hand (no rendering)."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import re
@@ -46,6 +47,7 @@ from sgdata.dataset import (
 from sgdata.dataset.schema import (
     FORMAT_VERSION,
     file_schema,
+    is_image_field,
     observations_schema,
     triplets_schema,
 )
@@ -273,7 +275,10 @@ def test_plain_tools_read_the_files(tmp_path: Path) -> None:
     back = pq.read_table(obs)  # on disk: the image as the Hugging Face {bytes, path} struct
     stored = file_schema(observations_schema())
     assert back.schema.equals(stored, check_metadata=True)
-    assert back.drop_columns("image").equals(table.drop_columns("image"))
+    images = [f.name for f in observations_schema() if is_image_field(f)]  # image + channels
+    assert back.drop_columns(images).equals(table.drop_columns(images))
+    for channel in images[1:]:  # obs_table stores no channels: null structs on disk
+        assert back.column(channel).null_count == back.num_rows
     assert back.column("image").to_pylist() == [
         {"bytes": b, "path": None} for b in table.column("image").to_pylist()
     ]
@@ -434,6 +439,15 @@ def test_newer_minor_drops_unknown_keys() -> None:
 # --------------------------------------------------------------------------- reader
 
 
+def with_channels(record: ViewRecord) -> ViewRecord:
+    """``record`` with a depth map and an instance mask (each object fills its 2D box)."""
+    instances = np.zeros((record.image_height, record.image_width), np.uint16)
+    for k, (x0, y0, x1, y1) in enumerate(record.obj_box2d, start=1):
+        instances[y0 : y1 + 1, x0 : x1 + 1] = k
+    depth = np.where(instances > 0, 1.5, 0.0).astype(np.float32)
+    return dataclasses.replace(record, depth=depth, instances=instances)
+
+
 def build_tiny_dataset(root: Path) -> Path:
     """A hand-assembled dataset at ``root``: train (2 rooms), val (1 room), triplets, manifest."""
     splits = {"train": ["kitchen_000", "kitchen_001"], "val": ["kitchen_002"]}
@@ -441,8 +455,9 @@ def build_tiny_dataset(root: Path) -> Path:
     for split, rooms in splits.items():
         ids: set[str] = set()
         for n, room in enumerate(rooms):
+            records = [with_channels(r) for r in room_records(room, seed=n)]  # as `tiny` writes
             table = observation_table(
-                room_records(room, seed=n), room_type="kitchen", split=split, class_ids=CLASS_IDS
+                records, room_type="kitchen", split=split, class_ids=CLASS_IDS
             )
             ids |= set(table.column("obs_id").to_pylist())
             rel = observations_path(split, room)
