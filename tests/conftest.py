@@ -1,5 +1,6 @@
 """Shared test fixtures: a tiny hand-built room with its render geometry, one renderer, the
-mini dataset, process probes, and a session-end check that no process of the run survives."""
+mini dataset, tiny seannet runs (a localizer, a navigation run), process probes, and a
+session-end check that no process of the run survives."""
 
 from __future__ import annotations
 
@@ -246,6 +247,96 @@ def channels_dataset(tmp_path_factory: pytest.TempPathFactory) -> Path:
     root = tmp_path_factory.mktemp("channels_dataset") / "data"
     generate_dataset(load_config(config_file), root, workers=2)
     return root
+
+
+# --------------------------------------------------------------------------- seannet runs
+# Trained in seconds on the mini dataset, shared by the seannet tests and the tests of the
+# bench scripts (tests/bench/) that read them. seannet is imported in the fixtures, so a
+# session of sgdata tests never loads it.
+
+
+def tiny_localizer_config():  # noqa: ANN201  (seannet.training.config.TrainConfig)
+    """A localizer run in seconds: the ResNet-18 baseline at 64 px, one batch of two triplets."""
+    from seannet.training.config import TrainConfig
+
+    return TrainConfig().replace(
+        model="resnet18",
+        image_size=64,
+        embed_dim=64,
+        epochs=1,
+        batch_size=2,
+        max_train_batches=1,
+        num_workers=0,
+    )
+
+
+@pytest.fixture
+def tiny_seannet():  # noqa: ANN201  (seannet.training.config.TrainConfig)
+    """SeanNet in seconds: ResNet-18 at 64 px, an 8 x 8 layout pathway, one batch of four
+    triplets."""
+    from seannet.training.config import TrainConfig
+
+    return TrainConfig().replace(
+        depth=18,
+        image_size=64,
+        roi_size=4,
+        visual_features="c5",
+        embed_dim=64,
+        layout_grid=8,
+        layout_sketch=0,
+        epochs=1,
+        batch_size=4,
+        max_train_batches=1,
+        num_workers=0,
+    )
+
+
+@pytest.fixture(scope="session")
+def localizer_run(tmp_path_factory: pytest.TempPathFactory, mini_dataset: Path) -> Path:
+    """A run directory (best.pt) trained on the mini dataset; no eval file, so no epsilon."""
+    from seannet.training.train import train
+
+    run = tmp_path_factory.mktemp("localizer") / "run"
+    train(tiny_localizer_config(), mini_dataset, run)
+    return run
+
+
+def tiny_navigation() -> dict:
+    """What the tiny navigation run used: the kill-and-resume test runs it again with these."""
+    from seannet.navigation.config import NavigationTestConfig
+
+    return {"config": NavigationTestConfig(episodes=2, replan=True), "epsilon": 0.95}
+
+
+@pytest.fixture(scope="session")
+def navigation_run(
+    tmp_path_factory: pytest.TempPathFactory, localizer_run: Path, mini_dataset: Path
+) -> SimpleNamespace:
+    """A navigator trained in seconds, and ``seannet navigate`` of the tiny localizer with
+    it on the mini dataset's test room (two workers, paper rule and --replan, strips)."""
+    from seannet.navigation.benchmark import run_navigation
+    from seannet.navigation.navigator import NavigatorConfig
+    from seannet.navigation.navigator_training import train_navigator
+
+    root = tmp_path_factory.mktemp("navigation")
+    config = NavigatorConfig(
+        image_size=64, hidden=16, epochs=1, batch_size=8, train_pairs=8, val_pairs=4
+    )
+    history = train_navigator(config, mini_dataset, root / "nav")
+    options = tiny_navigation()
+    results = run_navigation(
+        [localizer_run],
+        root / "nav",
+        mini_dataset,
+        workers=2,
+        out=root / "out",
+        strips=root / "strips",
+        **options,
+    )
+    return SimpleNamespace(
+        navigator=root / "nav", out=root / "out", strips=root / "strips", history=history,
+        results=results, options=options,
+    )  # fmt: skip
 
 
 # --------------------------------------------------------------------------- processes

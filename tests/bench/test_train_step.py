@@ -10,9 +10,7 @@ import sys
 from pathlib import Path
 from types import ModuleType
 
-from ...bench_scripts import load_bench
-
-ROOT = Path(__file__).resolve().parents[3]
+from ..bench_scripts import BENCH, load_bench
 
 
 def _bench() -> ModuleType:
@@ -26,7 +24,7 @@ def _number(cell: str) -> float:
 def test_profile_books_the_whole_step_to_parts(mini_dataset: Path, tmp_path: Path) -> None:
     data = tmp_path / "data"  # the bench builds the image cache inside the dataset it reads:
     shutil.copytree(mini_dataset, data)  # a copy keeps the shared fixture's bytes as they were
-    command = [sys.executable, str(ROOT / "bench/train_step.py"), str(data), "--profile"]
+    command = [sys.executable, str(BENCH / "train_step.py"), str(data), "--profile"]
     env = {**os.environ, "OMP_NUM_THREADS": "1"}  # one step of 2 triplets, quick on busy cores
     out = subprocess.run(
         [*command, "--batch-size", "2", "--steps", "1"],
@@ -66,13 +64,13 @@ def test_the_step_comparison_and_branch_motion_train_by_the_library_step(
     shutil.copytree(mini_dataset, data)
     env = {**os.environ, "OMP_NUM_THREADS": "1"}
     steps = subprocess.run(
-        [sys.executable, str(ROOT / "bench/train_step.py"), str(data), "--batch-size", "2",
+        [sys.executable, str(BENCH / "train_step.py"), str(data), "--batch-size", "2",
          "--steps", "1"],
         capture_output=True, text=True, env=env, check=True,
     ).stdout  # fmt: skip
     assert "resnet18 training step, batch 2:" in steps and "seannet / resnet18 step:" in steps
     motion = subprocess.run(
-        [sys.executable, str(ROOT / "bench/branch_motion.py"), str(data), "--batches", "1"],
+        [sys.executable, str(BENCH / "branch_motion.py"), str(data), "--batches", "1"],
         capture_output=True, text=True, env=env, check=True,
     ).stdout  # fmt: skip
     moved = {

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
 import json
 from pathlib import Path
 
@@ -10,20 +9,13 @@ from seannet.evaluation.compare import compare_models
 from seannet.provenance import append_provenance
 from seannet.training.config import TrainConfig
 
-ROOT = Path(__file__).resolve().parents[3]
-
-
-def _results_script():  # noqa: ANN202
-    spec = importlib.util.spec_from_file_location("results", ROOT / "bench" / "results.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+from ..bench_scripts import load_bench
 
 
 def test_tables_are_the_runs_figures(
     tmp_path: Path, mini_dataset: Path, tiny_seannet: TrainConfig
 ) -> None:
-    results = _results_script()
+    results = load_bench("results")
     runs = tmp_path / "runs"
     head = compare_models(
         mini_dataset,

@@ -11,9 +11,8 @@ import pytest
 
 from seannet.provenance import append_provenance, read_provenance
 
-from ...bench_scripts import load_bench
+from ..bench_scripts import load_bench
 
-ROOT = Path(__file__).resolve().parents[3]
 DOC = """# Navigation
 
 <!-- bench/navigation.py: paper -->
