@@ -15,6 +15,7 @@ from seannet.model.config import ModelConfig
 from seannet.model.seannet import SeanNet
 from seannet.model.specs import ABLATIONS, MODEL_NAMES, SEANNET
 from seannet.model.wordvectors import WordVectorTable
+from sgdata.annotate.slots import NUM_SLOTS
 
 __all__ = ["ABLATIONS", "LAYOUT_PRIOR", "MODEL_NAMES", "build_model"]
 
@@ -28,7 +29,7 @@ LAYOUT_PRIOR = {"static": 1.0, "low": 1.0, "high": 0.25}
 def build_model(
     model: ModelConfig | str = "seannet",
     *,
-    num_slots: int = 256,
+    num_slots: int = NUM_SLOTS,
     word_vectors: WordVectorTable | None = None,
     class_names: Sequence[str] | None = None,
     class_dynamics: Sequence[str] | None = None,

@@ -17,6 +17,7 @@ from seannet.model.backbones import efficientnet_lite0_c4, resnet_c4
 from seannet.model.config import VISUAL_FEATURES, ModelConfig
 from seannet.model.layers import MultiPathwayGCN, ObjectEmbedding, SlotLayout
 from seannet.model.layers.object_embedding import OBJECT_INPUTS
+from sgdata.annotate.slots import NUM_SLOTS
 
 __all__ = ["BRANCHES", "SeanNet"]
 
@@ -101,7 +102,7 @@ class SeanNet(nn.Module):
         word_vectors: Tensor | np.ndarray,
         *,
         depth: int = _DEFAULT.depth,
-        num_slots: int = 256,
+        num_slots: int = NUM_SLOTS,
         roi_size: int = _DEFAULT.roi_size,
         box_dim_per_coord: int = 64,
         object_dims: Sequence[int] = (1024, 512),

@@ -38,6 +38,7 @@ SEANNET_MAY_IMPORT = (
     "sgdata.scene_files",
     "sgdata.lazy_face",
     "sgdata.annotate.relations",  # the relation types: the dataset's own vocabulary
+    "sgdata.annotate.slots",  # M, the slot count: the dataset's own slot table
     "sgdata.world.catalog",  # the class vocabulary when a model is built without a dataset
     "sgdata.pipeline.executors",  # spawned workers that die with their parent (navigate)
 )

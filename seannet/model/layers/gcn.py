@@ -11,6 +11,7 @@ from torch import Tensor, nn
 
 from seannet.errors import ModelError
 from seannet.model.layers.column_linear import ColumnLinear
+from sgdata.annotate.slots import NUM_SLOTS
 
 __all__ = ["GCNLayer", "GCNPathway", "MultiPathwayGCN", "NodeEdges"]
 
@@ -163,7 +164,7 @@ class MultiPathwayGCN(nn.Module):
 
     def __init__(
         self,
-        num_slots: int = 256,
+        num_slots: int = NUM_SLOTS,
         dims: Sequence[int] = (512, 256, 64, 8),
         *,
         num_relations: int = 3,
