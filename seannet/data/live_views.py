@@ -21,7 +21,8 @@ import torch
 # torchvision's models import) each bring an LLVM, and loading triton after Mesa segfaults.
 # This module is the only one of seannet that renders, so the order is kept here.
 import torch._dynamo  # noqa: F401  isort: skip
-from seannet.data.datasets import ImageTransform, ViewTensors, open_dataset
+from seannet.data.datasets import ImageTransform, ViewTensors
+from seannet.data.opening import DataSource, open_dataset
 from seannet.data.view_inputs import graph_from_columns
 from seannet.errors import DataError
 from sgdata.dataset import Dataset, decode_image
@@ -87,14 +88,14 @@ class LiveRooms:
     manager, or call :meth:`close`.
 
     Args:
-        data: the dataset root (made by ``sgdata generate``).
+        data: the dataset (made by ``sgdata generate``): opened already, or its root.
 
     Raises:
         DataError: the dataset is missing or is not a generated one.
         RenderError: EGL cannot start.
     """
 
-    def __init__(self, data: Path) -> None:
+    def __init__(self, data: DataSource) -> None:
         from sgdata.annotate.annotator import ViewAnnotator
         from sgdata.annotate.relations import RelationRules
         from sgdata.annotate.slots import SlotTable
@@ -102,8 +103,8 @@ class LiveRooms:
         from sgdata.render.renderer import Renderer
         from sgdata.world.poses import PosesConfig
 
-        self.data = Path(data)
         self.dataset = open_dataset(data)
+        self.data = self.dataset.root
         self.settings = RenderSettings.of(self.dataset)
         m = self.dataset.manifest
         self.num_slots = int(m.num_slots)

@@ -24,8 +24,8 @@ import numpy as np
 import torch
 from torch.nn import functional as F
 
-from seannet.data.datasets import dataset_identity
 from seannet.data.live_views import LiveRooms
+from seannet.data.opening import dataset_identity, open_dataset
 from seannet.errors import CheckpointError
 from seannet.navigation.motion import NAVIGATOR_ACTIONS
 from seannet.navigation.navigator import KIND, NavigatorConfig, VisualNavigator, navigator_inputs
@@ -66,11 +66,12 @@ def train_navigator(
     """
     if (out / LAST).exists():
         raise CheckpointError(f"{out}: holds a navigator run already; pick another --out")
-    identity = dataset_identity(data)
-    append_provenance(out, data, step="train-navigator")
+    dataset = open_dataset(data)  # the manifest read once: identity, provenance, live rooms
+    identity = dataset_identity(dataset)
+    append_provenance(out, dataset, step="train-navigator")
     if progress is not None:
         progress("render", 0, 1, {})
-    with LiveRooms(data) as live:
+    with LiveRooms(dataset) as live:
         train_set = render_pairs(
             live, "train", config.train_pairs, config, cache=cache, identity=identity
         )
