@@ -1,5 +1,6 @@
 """A command opens its dataset once (STYLE.md habit 15): ``dataset.json`` is read one time per
-``compare``, ``eval`` or ``train``, however many loaders, checkpoints and records sit below."""
+``compare``, ``eval``, ``train`` or ``train-navigator``, however many loaders, checkpoints and
+records sit below."""
 
 from __future__ import annotations
 
@@ -81,3 +82,17 @@ def test_train_and_eval_read_the_manifest_once_each(
     assert manifest_reads.of(mini_dataset) == 1
     evaluate_run(run, mini_dataset, split="val", boxes="+box-kernel")
     assert manifest_reads.of(mini_dataset) == 2
+
+
+def test_train_navigator_reads_the_manifest_once(
+    tmp_path: Path, mini_dataset: Path, manifest_reads: ManifestReads
+) -> None:
+    # identity, provenance and the live rooms that render its pairs share one opening
+    from seannet.navigation.navigator import NavigatorConfig
+    from seannet.navigation.navigator_training import train_navigator
+
+    config = NavigatorConfig(
+        image_size=64, hidden=16, epochs=1, batch_size=8, train_pairs=8, val_pairs=4
+    )
+    train_navigator(config, mini_dataset, tmp_path / "nav")
+    assert manifest_reads.of(mini_dataset) == 1
