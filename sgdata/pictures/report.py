@@ -18,6 +18,7 @@ from PIL import Image, ImageDraw, ImageFont
 
 from sgdata import markdown
 from sgdata.dataset import Dataset
+from sgdata.world.poses import HEADINGS_DEG
 
 __all__ = ["write_report", "bar_chart", "channel_sheet", "contact_sheet"]
 
@@ -323,8 +324,8 @@ def write_report(
         ),
         "headings.png": bar_chart(
             "Views per heading",
-            [f"{90 * h} deg" for h in range(4)],
-            [headings[h] for h in range(4)],
+            [f"{degrees} deg" for degrees in HEADINGS_DEG],
+            [headings[h] for h in range(len(HEADINGS_DEG))],
             xlabel="views",
         ),
         "visible_objects.png": bar_chart(
