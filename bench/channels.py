@@ -29,7 +29,7 @@ from sgdata.dataset.vocabulary import class_vocabulary  # noqa: E402
 from sgdata.render.renderer import Renderer  # noqa: E402
 from sgdata.usd.geometry import read_geometry  # noqa: E402
 from sgdata.usd.room_io import read_room  # noqa: E402
-from sgdata.world.poses import PosesConfig  # noqa: E402
+from sgdata.world.poses import HEADINGS_DEG, PosesConfig  # noqa: E402
 
 
 def main() -> None:
@@ -41,10 +41,11 @@ def main() -> None:
     layout = sorted((args.root / "scenes").glob("*/layout_0.usda"))[0]
     room, geometry = read_room(layout), read_geometry(layout)
     grid = PosesConfig().grid(room)
-    cells = grid.cells[:: max(1, len(grid.cells) // max(1, args.views // 4))]
-    poses = [ViewPose(*grid.pose_world(i, j, h), i, j, h) for i, j in cells for h in range(4)][
-        : args.views
-    ]
+    headings = len(HEADINGS_DEG)
+    cells = grid.cells[:: max(1, len(grid.cells) // max(1, args.views // headings))]
+    poses = [
+        ViewPose(*grid.pose_world(i, j, h), i, j, h) for i, j in cells for h in range(headings)
+    ][: args.views]
     slots, _ = class_vocabulary()
     renderer = Renderer()
     runs = {

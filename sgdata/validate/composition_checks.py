@@ -14,7 +14,7 @@ import pyarrow.compute as pc
 from sgdata.dataset.paths import MANIFEST
 from sgdata.validate.loading import SplitTables, column_numpy, fixed_numpy
 from sgdata.validate.problems import Collector
-from sgdata.world.triplets import TIERS, tier_counts
+from sgdata.world.triplets import HEADINGS, TIERS, tier_counts
 
 __all__ = ["check_triplets", "check_rooms_across_splits", "check_counts", "ROLES"]
 
@@ -187,8 +187,9 @@ def _check_offsets(
     a = grid["anchor"]
     for role in ("positive", "negative"):
         g = grid[role]
-        step = (g[:, 3] - a[:, 3]) % 4
-        offset = np.stack([g[:, 1] - a[:, 1], g[:, 2] - a[:, 2], np.where(step == 3, -1, step)], 1)
+        step = (g[:, 3] - a[:, 3]) % HEADINGS  # a turn of 3 quarters is one quarter back
+        turn = np.where(step == HEADINGS - 1, -1, step)
+        offset = np.stack([g[:, 1] - a[:, 1], g[:, 2] - a[:, 2], turn], 1)
         stored, _ = fixed_numpy(tri.table.column(f"{role}_offset").combine_chunks(), 3, np.int64)
         tri.report(
             "triplets.offsets",
