@@ -16,9 +16,11 @@ The protocol (DESIGN §12), in the order it runs:
 3. ``selection.json`` is written: each model's chosen lr, its val accuracy by lr, its runs.
    No test row has been read until then (``on_selected`` is called at that point).
 4. **Test, once.** Each chosen run is evaluated on the test split.
-5. **Intervals.** Per model, a two-level bootstrap over rooms and seeds and the seed-level
-   t-interval; for the first model minus each other, the paired two-level bootstrap and
-   Welch's seed-level interval (:mod:`seannet.evaluation.intervals`).
+5. **Intervals.** Per model, the two-level interval over rooms and seeds (variance
+   components: a room bootstrap's variance plus the seeds' over their number, t on seeds - 1
+   dof) and the seed-level t-interval; for the first model minus each other, the same with
+   one room draw for both (paired) and Welch's seed-level interval
+   (:mod:`seannet.evaluation.intervals`).
 
 A model is named by a spec ``NAME[@net][+imagenet][+boxes|+box-kernel]``
 (:mod:`seannet.model.specs`): ``NAME`` a model or ablation (``seannet``, ``seannet-graph``,
@@ -293,7 +295,8 @@ def _two_level(runs: list[dict[str, Any]], counts: dict[str, int]) -> dict[str, 
 def _difference(
     runs_a: list[dict[str, Any]], runs_b: list[dict[str, Any]], counts: dict[str, int]
 ) -> dict[str, Any]:
-    """A minus B: paired two-level bootstrap over rooms and seeds, and Welch over seeds."""
+    """A minus B: the two-level interval (paired room bootstrap's variance plus each model's
+    seed variance, t on the smaller seed count - 1 dof), and Welch over seeds."""
     rooms = sorted(counts)
     weight = np.array([counts[r] for r in rooms], dtype=np.float64)
     a, b = per_room_matrix(runs_a, rooms), per_room_matrix(runs_b, rooms)
@@ -350,8 +353,10 @@ def markdown(results: dict[str, Any]) -> str:
         first = results["models"][0]["model"]
         rows += [
             "",
-            f"{first} minus each model on the same rooms, points: paired two-level bootstrap "
-            "(rooms x seeds) and Welch's seed-level t-interval, 95 %:",
+            f"{first} minus each model on the same rooms, points, 95 %: rooms x seeds (the "
+            "variance of a room bootstrap paired on the rooms plus each model's seed variance "
+            "over its seeds, t on the smaller seed count - 1 dof) and Welch's seed-level "
+            "t-interval:",
             "",
             "| model | rooms x seeds | seeds (t) |",
             "|---|---|---|",

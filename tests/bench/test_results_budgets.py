@@ -1,0 +1,100 @@
+"""bench/results.py, like for like: the boxes section is the headline's runs, every network of
+a section gets one budget rule, and the doc says what each got (or that it was not recorded)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from seannet.provenance import append_provenance
+from seannet.training.config import TrainConfig
+
+from ..bench_scripts import load_bench
+
+BUDGET_S = 0.05  # seconds of one thread: a batch per epoch for the tiny networks
+
+
+def _section(doc: str, title: str) -> str:
+    start = doc.index(f"## {title}")
+    end = doc.find("\n## ", start + 1)
+    return doc[start : end if end > 0 else None]
+
+
+def test_sections_compare_like_for_like(
+    tmp_path: Path, mini_dataset: Path, tiny_seannet: TrainConfig
+) -> None:
+    results = load_bench("results")
+    runs = tmp_path / "runs"
+    steps = {
+        "headline": ("seannet", "resnet18"),
+        "boxes": None,  # the step's own models
+        "ablations": ("seannet", "seannet-image"),
+    }
+    for step, models in steps.items():
+        append_provenance(runs, mini_dataset, step=step)
+        results.run_step(
+            mini_dataset,
+            runs,
+            step,
+            budget_s=BUDGET_S,
+            preset=tiny_seannet,
+            seeds=(0, 1),
+            lrs=(0.003, 0.01),
+            models=models,
+        )
+    head = {
+        m["model"]: m for m in json.loads((runs / "selection-headline.json").read_text())["models"]
+    }
+    boxes = json.loads((runs / "selection-boxes.json").read_text())
+    # the boxes step trains at the headline SeanNet's lr only: both rows are its runs
+    assert boxes["lrs"] == [head["seannet"]["lr"]]
+    assert all(m["runs"] == head["seannet"]["runs"] for m in boxes["models"])
+    # the ablations' SeanNet keeps the headline's calibrated batches; the image branch is
+    # calibrated by the same rule under the same budget
+    ablations = {
+        m["model"]: m for m in json.loads((runs / "selection-ablations.json").read_text())["models"]
+    }
+    assert ablations["seannet"]["budget"]["source"] == "recorded"
+    assert ablations["seannet"]["batches_per_epoch"] == head["seannet"]["budget"]["batches"]
+    assert ablations["seannet-image"]["budget"]["source"] == "calibrated"
+    assert ablations["seannet-image"]["budget"]["budget_s"] == BUDGET_S
+
+    doc = results.tables(runs)
+    section = _section(doc, "SeanNet plus the hand-made overlap")
+    assert (
+        "seannet+boxes: the headline seannet's runs; seannet: the headline seannet's runs"
+        in section
+    )
+    section = _section(doc, "Ablations")
+    for name, entry in ablations.items():
+        row = (
+            f"| {name} | {entry['trained']} | {entry['batches_per_epoch']} | {entry['epochs']} | "
+            f"{entry['examples']:,} |"
+        )
+        assert row in section
+    assert "| seannet | seannet | " in section and "calibrated in `headline`" in section
+    assert f"Like for like: every network's batches fill the same {BUDGET_S:g} s" in section
+
+    # a section whose runs are not the headline's says so, and names why
+    path = runs / "comparison-boxes.json"
+    tampered = json.loads(path.read_text())
+    other = tampered["models"][0]
+    other["lr"], other["val_accuracy_by_lr"]["0.1"] = 0.1, 0.5
+    for r in other["runs"]:
+        r["run"] = r["run"].replace("/lr", "/other-lr")
+    path.write_text(json.dumps(tampered))
+    section = _section(results.tables(runs), "SeanNet plus the hand-made overlap")
+    assert "the headline seannet's runs" in section  # the untouched row
+    assert "seannet+boxes: not the headline seannet's runs (lr 0.1 against" in section
+
+    # runs made before budgets were recorded: "not recorded", and no like-for-like claim
+    path = runs / "comparison-ablations.json"
+    old = json.loads(path.read_text())
+    for m in old["models"]:
+        del m["budget"], m["examples"]
+    path.write_text(json.dumps(old))
+    (runs / "selection-ablations.json").write_text(json.dumps(old | {"split": None}))
+    section = _section(results.tables(runs), "Ablations")
+    assert section.count("| not recorded |") == len(old["models"])
+    assert "Like for like not shown: seannet, seannet-image have no budget record" in section
+    assert "Like for like: every" not in section
