@@ -1,126 +1,444 @@
-"""Every benchmark of the pipeline in one run, as one table (docs/benchmarks.md).
+"""docs/benchmarks.md as code: run the benchmark scripts, keep what each printed, write the page.
 
-    .venv/bin/python bench/suite.py                      # ~10 min on 2 cores
-    .venv/bin/python bench/suite.py --rooms 24 --views 30 --validate out/medium
+    .venv/bin/python bench/suite.py run OUT                 # the suite, then the page (~10 min)
+    .venv/bin/python bench/suite.py run OUT --rooms 24 --views 30 --validate out/results \\
+        --extras channels,assets,fuzz                       # and the scripts the suite skips
+    .venv/bin/python bench/suite.py page OUT                # the page again from OUT
 
-Rows, each measured in a fresh process on this machine, one after the other:
+``run`` runs each measure in a fresh process, one after the other, and keeps its figures in
+``OUT/<measure>.json`` with a stamp taken when the measure started: commit and dirty flag,
+the machine (CPU, cores, memory, GPU), the load average, the date (UTC), and the command.
+Every script's figures are its own machine-readable output (``--json``; the loader's table as
+it printed it). ``page`` writes docs/benchmarks.md atomically from those files and nothing
+else: no figure in it is typed by hand. A measure with no file in ``OUT`` is listed with the
+command that measures it; figures measured before the page was generated live, dated and
+fingerprinted, in :data:`OLDER` (the page names its sha256 and the commits it quotes).
+
+Measures:
 
 - render: annotated views/s of the pipeline (merged RGB mesh + id pass + boxes, slots,
   relations) against plain pyrender (one node per object, an RGB and a SEG pass) on the same
-  views of 4 generated rooms, both on one llvmpipe thread (``LP_NUM_THREADS=1``);
+  views of 4 generated rooms, both on one llvmpipe thread (``LP_NUM_THREADS=1``), flat and
+  textured;
 - generate: ``sgdata generate`` end to end on ``--rooms`` rooms with 1 and 2 local workers
   and with Ray (a local instance, 2 workers);
-- loader: ``bench/loader.py`` on the ``tiny`` preset (its own table follows);
-- validate: ``sgdata validate`` on a dataset (``--validate``, default the tiny one).
-
-The ratios the project holds itself to: pipeline >= 2x plain pyrender on textured views (issue
-25; >= 1.3x flat before); textured pipeline >= 0.8x the flat one; 2 workers >= 1.8x one; Ray
-local within 0.8x of the local pool.
+- loader: ``bench/loader.py`` on a ``tiny`` dataset generated for the run;
+- validate: ``sgdata validate`` on a dataset (``--validate``, default that ``tiny`` one);
+- extras (``--extras``): ``bench/channels.py``, ``bench/assets.py``, ``bench/fuzz.py``.
 """
 
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 import os
+import platform
+import re
+import shutil
 import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any, NamedTuple
 
 BENCH = Path(__file__).resolve().parent
+ROOT = BENCH.parent
+sys.path.insert(0, str(ROOT))
+
+from seannet.provenance import ProcessState  # noqa: E402
+from sgdata.fileio import atomic_write_text  # noqa: E402
+
 PY = sys.executable
+PAGE = ROOT / "docs" / "benchmarks.md"
+# the hand-assembled page this generator replaced: its figures, each naming its commit
+OLDER = ROOT / "docs" / "benchmarks-2026-12-03.md"
+CORE = ("render", "generate", "loader", "validate")
+EXTRAS = ("channels", "assets", "fuzz")
+# the ratios the project holds itself to (issue 25): aims, not measurements
+AIMS = {
+    "textured: pipeline/naive": ">= 2x",
+    "textured/flat": ">= 0.8x",
+    "2 workers / 1": ">= 1.8x",
+    "Ray local / local pool": ">= 0.8x",
+    "channels / RGB only": ">= 0.85x",
+    "meshes / procedural, annotated view": ">= 0.5x",
+}
 
 
-def _json_line(command: list[str], env: dict | None = None) -> dict:
-    out = subprocess.run(command, capture_output=True, text=True, env=env, check=True)
-    return json.loads(out.stdout.strip().splitlines()[-1])
+def machine_stamp() -> dict[str, Any]:
+    """The code and the machine now: commit and dirty flag, CPU, cores, memory, GPU, the
+    1-minute load average, the date (UTC)."""
+    code = ProcessState.capture(ROOT)
+    cpu = platform.processor() or platform.machine()
+    cpuinfo = Path("/proc/cpuinfo")
+    if cpuinfo.is_file():
+        names = re.findall(r"^model name\s*:\s*(.+)$", cpuinfo.read_text(), re.MULTILINE)
+        cpu = names[0].strip() if names else cpu
+    memory = (
+        os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") if hasattr(os, "sysconf") else 0
+    )
+    gpu = ""
+    if shutil.which("nvidia-smi"):
+        listed = subprocess.run(["nvidia-smi", "-L"], capture_output=True, text=True, check=False)
+        gpu = "; ".join(listed.stdout.strip().splitlines())
+    return {
+        "commit": code.commit,
+        "dirty": code.dirty,
+        "cpu": cpu,
+        "cores": os.cpu_count(),
+        "memory_gib": round(memory / 2**30, 1),
+        "gpu": gpu or "none",
+        "load_average": round(os.getloadavg()[0], 2),
+        "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
+    }
+
+
+def _last_json(stdout: str) -> Any:
+    return json.loads(stdout.strip().splitlines()[-1])
+
+
+def _json_lines(stdout: str) -> list[Any]:
+    return [json.loads(line) for line in stdout.splitlines() if line.startswith("{")]
+
+
+class Measure(NamedTuple):
+    """One script the suite runs: its commands (from the arguments and a tiny dataset), how
+    its output is read (parse: each command's stdout, the wall seconds of them all, the
+    commands) and shown (section). A named tuple, not a dataclass: tests load this script
+    without registering it as a module."""
+
+    title: str
+    commands: Callable[[argparse.Namespace, Path], list[list[str]]]
+    parse: Callable[[list[str], float, list[list[str]]], Any]
+    section: Callable[[Any], list[str]]
+    env: dict[str, str] | None = None
+
+
+def _render_commands(args: argparse.Namespace, tiny: Path) -> list[list[str]]:
+    return [[PY, str(BENCH / "render.py"), "--rooms", "4", "--views", str(args.views), "--json"]]
+
+
+def _render_section(r: dict[str, Any]) -> list[str]:
+    rows = [
+        ("pipeline, flat (annotated views/s)", f"{r['pipeline']:.1f}", ""),
+        ("plain pyrender RGB + SEG, flat (views/s)", f"{r['naive']:.1f}", ""),
+        ("pipeline / plain pyrender, flat", f"{r['pipeline/naive']:.2f}x", ""),
+        ("pipeline, textured (annotated views/s)", f"{r['pipeline_textured']:.1f}", ""),
+        ("plain pyrender, textured (views/s)", f"{r['naive_textured']:.1f}", ""),
+        (
+            "**pipeline / plain pyrender, textured**",
+            f"**{r['textured: pipeline/naive']:.2f}x**",
+            AIMS["textured: pipeline/naive"],
+        ),
+        ("pipeline textured / flat", f"{r['textured/flat']:.2f}x", AIMS["textured/flat"]),
+    ]
+    return _table(("measurement", "figure", "aim"), rows)
+
+
+def _generate_commands(args: argparse.Namespace, tiny: Path) -> list[list[str]]:
+    one = [PY, str(BENCH / "generate.py"), "--one", str(args.rooms)]
+    return [
+        [*one, str(workers), "--executor", executor]
+        for workers, executor in ((1, "local"), (2, "local"), (2, "ray"))
+    ]
+
+
+def _generate_section(runs: list[dict[str, Any]]) -> list[str]:
+    one, two, ray = runs
+    rows = [
+        (
+            f"{label}: {r['views']} views in {r['wall_s']} s",
+            f"{r['views_per_s']:.2f} views/s",
+            "",
+        )
+        for label, r in zip(
+            ("local, 1 worker", "local, 2 workers", "Ray, 2 workers"), runs, strict=True
+        )
+    ]
+    rows += [
+        (
+            "**2 workers / 1**",
+            f"{two['views_per_s'] / one['views_per_s']:.2f}x",
+            AIMS["2 workers / 1"],
+        ),
+        (
+            "**Ray local / local pool**",
+            f"{ray['views_per_s'] / two['views_per_s']:.2f}x",
+            AIMS["Ray local / local pool"],
+        ),
+    ]
+    return _table(("run", "figure", "aim"), rows)
+
+
+def _loader_commands(args: argparse.Namespace, tiny: Path) -> list[list[str]]:
+    return [[PY, str(BENCH / "loader.py"), "--data", str(tiny)]]
+
+
+def _text_section(text: str) -> list[str]:
+    """A script's own printed table, as it printed it."""
+    return ["```text", text.strip(), "```"]
+
+
+def _validate_commands(args: argparse.Namespace, tiny: Path) -> list[list[str]]:
+    return [[PY, "-m", "sgdata_cli.sgdata_app", "validate", str(args.validate or tiny)]]
+
+
+def _validate_section(r: dict[str, Any]) -> list[str]:
+    return _table(("dataset", "seconds"), [(f"`{r['dataset']}`", f"{r['seconds']:.1f}")])
+
+
+def _channels_commands(args: argparse.Namespace, tiny: Path) -> list[list[str]]:
+    return [[PY, str(BENCH / "channels.py"), str(tiny), "--views", str(args.views), "--json"]]
+
+
+def _channels_section(r: dict[str, Any]) -> list[str]:
+    rates = r["views_per_s"]
+    rows = [
+        ("RGB only (views/s)", f"{rates['rgb']:.1f}", ""),
+        ("RGB + depth + instances (views/s)", f"{rates['channels']:.1f}", ""),
+        ("channels / RGB only", f"{r['ratio']:.2f}x", AIMS["channels / RGB only"]),
+        *((f"PNG bytes per view, {k}", f"{v:,}", "") for k, v in r["bytes_per_view"].items()),
+    ]
+    return [
+        f"Room `{r['room']}`, {r['views']} views, each run twice (ABAB).",
+        "",
+        *_table(("measurement", "figure", "aim"), rows),
+    ]
+
+
+def _assets_commands(args: argparse.Namespace, tiny: Path) -> list[list[str]]:
+    return [[PY, str(BENCH / "assets.py"), "--views", str(args.views), "--json"]]
+
+
+def _assets_section(r: dict[str, Any]) -> list[str]:
+    rows = [(f"`{k}`", f"{v}") for k, v in r.items() if not k.startswith("ratio_")]
+    ratios = [
+        (f"meshes / procedural, {k.removeprefix('ratio_')}", f"{v:.2f}x")
+        for k, v in r.items()
+        if k.startswith("ratio_")
+    ]
+    return [*_table(("ratio", "figure"), ratios), "", *_table(("figure", "value"), rows)]
+
+
+def _fuzz_commands(args: argparse.Namespace, tiny: Path) -> list[list[str]]:
+    return [[PY, str(BENCH / "fuzz.py"), "--examples", "200", "--json"]]
+
+
+def _fuzz_section(reports: list[dict[str, Any]]) -> list[str]:
+    rows = [
+        (
+            r["surface"],
+            str(r["tried"]),
+            str(r["refused"]),
+            str(len(r["failures"])),
+            f"{r['seconds']:.0f}",
+        )
+        for r in reports
+    ]
+    return _table(("surface", "tried", "refused", "failures", "seconds"), rows)
+
+
+def _table(header: tuple[str, ...], rows: list[tuple[str, ...]]) -> list[str]:
+    return [
+        "| " + " | ".join(header) + " |",
+        "|" + "---|" * len(header),
+        *("| " + " | ".join(row) + " |" for row in rows),
+    ]
+
+
+_LP1 = {"LP_NUM_THREADS": "1"}
+MEASURES: dict[str, Measure] = {
+    "render": Measure(
+        "Rendering, one llvmpipe thread (`bench/render.py`)",
+        _render_commands,
+        lambda outs, _s, _c: _last_json(outs[0]),
+        _render_section,
+        env=_LP1,
+    ),
+    "generate": Measure(
+        "`sgdata generate` end to end (`bench/generate.py`)",
+        _generate_commands,
+        lambda outs, _s, _c: [_last_json(o) for o in outs],
+        _generate_section,
+    ),
+    "loader": Measure(
+        "Training dataloader (`bench/loader.py`)",
+        _loader_commands,
+        lambda outs, _s, _c: outs[0],
+        _text_section,
+    ),
+    "validate": Measure(
+        "`sgdata validate`",
+        _validate_commands,
+        lambda _outs, seconds, commands: {
+            "dataset": Path(commands[0][-1]).name,
+            "seconds": round(seconds, 2),
+        },
+        _validate_section,
+    ),
+    "channels": Measure(
+        "Channels: depth and instance masks (`bench/channels.py`)",
+        _channels_commands,
+        lambda outs, _s, _c: _last_json(outs[0]),
+        _channels_section,
+        env=_LP1,
+    ),
+    "assets": Measure(
+        "Objects you bring: a room of mesh files (`bench/assets.py`)",
+        _assets_commands,
+        lambda outs, _s, _c: _last_json(outs[0]),
+        _assets_section,
+        env=_LP1,
+    ),
+    "fuzz": Measure(
+        "Fuzz campaign (`bench/fuzz.py`)",
+        _fuzz_commands,
+        lambda outs, _s, _c: _json_lines(outs[0]),
+        _fuzz_section,
+    ),
+}
+
+
+def run_measure(name: str, args: argparse.Namespace, tiny: Path, out: Path) -> dict[str, Any]:
+    """Run one measure's commands, each in a fresh process; write ``out/<name>.json``
+    (atomically) with the stamp taken at its start, the commands and the parsed figures."""
+    measure = MEASURES[name]
+    stamp = machine_stamp()
+    env = {**os.environ, **(measure.env or {})}
+    commands = measure.commands(args, tiny)
+    outputs, start = [], time.perf_counter()
+    for command in commands:
+        done = subprocess.run(command, capture_output=True, text=True, env=env, check=False)
+        if done.returncode != 0 and name != "fuzz":  # fuzz exits 1 when it found a failure
+            raise SystemExit(f"{name}: {' '.join(command)} failed:\n{done.stderr[-2000:]}")
+        outputs.append(done.stdout)
+    seconds = time.perf_counter() - start
+    result = measure.parse(outputs, seconds, commands)
+    record = {"measure": name, "stamp": stamp, "commands": commands, "result": result}
+    out.mkdir(parents=True, exist_ok=True)
+    atomic_write_text(out / f"{name}.json", json.dumps(record, indent=2))
+    return record
+
+
+def _stamp_line(record: dict[str, Any]) -> str:
+    s = record["stamp"]
+    dirty = " with uncommitted changes" if s["dirty"] else ""
+    commands = "; ".join(
+        "`" + " ".join(Path(c).name if c == PY else _short(c) for c in command) + "`"
+        for command in record["commands"]
+    )
+    return (
+        f"*Measured {s['date']} at commit `{s['commit'][:10]}`{dirty} on {s['cores']} x "
+        f"{s['cpu']}, {s['memory_gib']} GiB, GPU {s['gpu']}, load average "
+        f"{s['load_average']:.2f} at the start: {commands}.*"
+    )
+
+
+def _short(arg: str) -> str:
+    """An argument as the page shows it: paths under the checkout relative to it."""
+    try:
+        return str(Path(arg).relative_to(ROOT))
+    except ValueError:
+        return arg
+
+
+def _older_section(older: Path) -> list[str]:
+    """The older page: dated, fingerprinted (sha256, the commits it quotes), its sections."""
+    if not older.is_file():
+        return []
+    text = older.read_text(encoding="utf-8")
+    digest = hashlib.sha256(text.encode("utf-8")).hexdigest()
+    commits = sorted(set(re.findall(r"`([0-9a-f]{7,10})`", text)))
+    sections = [line.removeprefix("## ") for line in text.splitlines() if line.startswith("## ")]
+    return [
+        "",
+        "## Older figures",
+        "",
+        f"Measured before this page was generated and assembled by hand, each section naming "
+        f"the commits it was measured at: [{older.name}]({older.name}) (sha256 "
+        f"`{digest[:16]}…`; commits quoted: {', '.join(f'`{c}`' for c in commits)}). "
+        "None of them is used above. Its sections: " + "; ".join(sections) + ".",
+    ]
+
+
+def page(out: Path, older: Path = OLDER) -> str:
+    """docs/benchmarks.md from the measures' files under ``out``."""
+    lines = [
+        "# Benchmarks",
+        "",
+        "Written by `python bench/suite.py page OUT` from the figures the benchmark scripts "
+        "printed (`OUT/<measure>.json`); no figure here is typed by hand. Each section says "
+        "when, at which commit and on which machine (with its load average) it was measured; "
+        "ratios are taken within one run. Re-run the suite to measure your machine.",
+    ]
+    missing = []
+    for name, measure in MEASURES.items():
+        path = out / f"{name}.json"
+        if not path.is_file():
+            missing.append(name)
+            continue
+        record = json.loads(path.read_text())
+        lines += [
+            "",
+            f"## {measure.title}",
+            "",
+            _stamp_line(record),
+            "",
+            *measure.section(record["result"]),
+        ]
+    if missing:
+        lines += ["", "## Not measured in this set", ""]
+        for name in missing:
+            flag = f" --extras {name}" if name in EXTRAS else ""
+            lines.append(f"- {MEASURES[name].title}: `python bench/suite.py run OUT{flag}`.")
+    lines += _older_section(older)
+    return "\n".join(lines) + "\n"
+
+
+def _generate_tiny(root: Path) -> None:
+    subprocess.run(
+        [PY, "-m", "sgdata_cli.sgdata_app", "generate", "tiny", str(root)],
+        check=True,
+        capture_output=True,
+    )
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--rooms", type=int, default=24, help="rooms of the generate runs")
-    parser.add_argument("--views", type=int, default=30, help="views per room of the render run")
-    parser.add_argument("--validate", type=Path, help="dataset to validate (default: tiny)")
+    sub = parser.add_subparsers(dest="verb", required=True)
+    go = sub.add_parser("run", help="run the measures into OUT, then write the page")
+    go.add_argument("out", type=Path, help="where each measure's JSON goes")
+    go.add_argument("--rooms", type=int, default=24, help="rooms of the generate runs")
+    go.add_argument("--views", type=int, default=30, help="views per room of the render run")
+    go.add_argument("--validate", type=Path, help="dataset to validate (default: tiny)")
+    go.add_argument("--only", help=f"these measures only, comma-separated ({', '.join(CORE)})")
+    go.add_argument("--extras", default="", help=f"also run these ({', '.join(EXTRAS)})")
+    go.add_argument("-o", "--output", type=Path, default=PAGE)
+    write = sub.add_parser("page", help="write the page from OUT")
+    write.add_argument("out", type=Path)
+    write.add_argument("-o", "--output", type=Path, default=PAGE)
     args = parser.parse_args()
-    rows: list[tuple[str, str, str]] = []
-
-    env = {**os.environ, "LP_NUM_THREADS": "1"}
-    render = _json_line(
-        [PY, str(BENCH / "render.py"), "--rooms", "4", "--views", str(args.views), "--json"], env
-    )
-    rows += [
-        ("render, 1 thread", "pipeline (annotated views/s)", f"{render['pipeline']:.1f}"),
-        ("render, 1 thread", "plain pyrender RGB + SEG (views/s)", f"{render['naive']:.1f}"),
-        ("render, 1 thread", "pipeline / plain pyrender", f"{render['pipeline/naive']:.2f}x"),
-        (
-            "render, 1 thread",
-            "pipeline with textures (annotated views/s)",
-            f"{render['pipeline_textured']:.1f}",
-        ),
-        (
-            "render, 1 thread",
-            "plain pyrender with textures (views/s)",
-            f"{render['naive_textured']:.1f}",
-        ),
-        (
-            "render, 1 thread",
-            "textured: pipeline / plain pyrender",
-            f"{render['textured: pipeline/naive']:.2f}x",
-        ),
-        ("render, 1 thread", "pipeline textured / flat", f"{render['textured/flat']:.2f}x"),
-    ]
-
-    runs = {}
-    for workers, executor in ((1, "local"), (2, "local"), (2, "ray")):
-        command = [PY, str(BENCH / "generate.py"), "--one", str(args.rooms), str(workers)]
-        runs[(workers, executor)] = run = _json_line([*command, "--executor", executor])
-        rows.append(
-            (
-                f"generate {args.rooms} rooms",
-                f"{executor}, {workers} worker(s): {run['views']} views in {run['wall_s']} s",
-                f"{run['views_per_s']:.2f} views/s",
+    if args.verb == "run":
+        names = [
+            *(args.only.split(",") if args.only else CORE),
+            *filter(None, args.extras.split(",")),
+        ]
+        unknown = [n for n in names if n not in MEASURES]
+        if unknown:
+            raise SystemExit(
+                f"unknown measure {', '.join(unknown)}: expected {', '.join(MEASURES)}"
             )
-        )
-    one, two, ray = runs[(1, "local")], runs[(2, "local")], runs[(2, "ray")]
-    rows.append(("generate", "2 workers / 1", f"{two['views_per_s'] / one['views_per_s']:.2f}x"))
-    rows.append(
-        ("generate", "Ray local / local pool", f"{ray['views_per_s'] / two['views_per_s']:.2f}x")
-    )
-
-    with tempfile.TemporaryDirectory() as tmp:
-        tiny = Path(tmp) / "tiny"
-        subprocess.run(
-            [PY, "-m", "sgdata_cli.sgdata_app", "generate", "tiny", str(tiny)],
-            check=True,
-            capture_output=True,
-        )
-        loader = subprocess.run(
-            [PY, str(BENCH / "loader.py"), "--data", str(tiny)],
-            capture_output=True,
-            text=True,
-            check=True,
-        ).stdout
-        target = args.validate or tiny
-        start = time.perf_counter()
-        subprocess.run(
-            [PY, "-m", "sgdata_cli.sgdata_app", "validate", str(target)],
-            check=True,
-            capture_output=True,
-        )
-        rows.append(("validate", f"{target.name}", f"{time.perf_counter() - start:.1f} s"))
-
-    commit = subprocess.run(
-        ["git", "-C", str(BENCH), "describe", "--always", "--dirty"], capture_output=True, text=True
-    ).stdout.strip()
-    print(f"commit {commit or 'unknown'}, {time.strftime('%Y-%m-%d')}, {os.cpu_count()} CPUs\n")
-    print("| benchmark | measurement | figure |")
-    print("|---|---|---|")
-    for row in rows:
-        print("| " + " | ".join(row) + " |")
-    print("\nloader (bench/loader.py on tiny):\n")
-    print(loader)
+        with tempfile.TemporaryDirectory() as tmp:
+            tiny = Path(tmp) / "tiny"
+            _generate_tiny(tiny)
+            for name in names:
+                print(f"{name} ...", flush=True)
+                run_measure(name, args, tiny, args.out)
+    atomic_write_text(args.output, page(args.out))
+    print(f"wrote {args.output}")
 
 
 if __name__ == "__main__":

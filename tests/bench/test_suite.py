@@ -1,0 +1,59 @@
+"""bench/suite.py: docs/benchmarks.md is written from the figures the scripts printed, each
+section stamped (commit, dirty flag, machine, load average, date); nothing typed by hand."""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+from pathlib import Path
+
+from ..bench_scripts import load_bench
+
+
+def test_the_page_is_the_scripts_figures(tmp_path: Path, mini_dataset: Path) -> None:
+    suite = load_bench("suite")
+    out = tmp_path / "bench"
+    args = argparse.Namespace(views=2, rooms=1, validate=None)
+    # real measures on the mini dataset: sgdata validate, and the channels script's JSON
+    validate = suite.run_measure("validate", args, mini_dataset, out)
+    channels = suite.run_measure("channels", args, mini_dataset, out)
+    stamp = validate["stamp"]
+    assert {"commit", "dirty", "cpu", "cores", "memory_gib", "gpu", "load_average", "date"} <= set(
+        stamp
+    )
+    assert json.loads((out / "validate.json").read_text()) == validate
+    # a generate record as bench/generate.py prints it: the page computes the ratios
+    runs = [
+        {"views": 70, "wall_s": 7.0, "views_per_s": 10.0},
+        {"views": 70, "wall_s": 3.5, "views_per_s": 20.0},
+        {"views": 70, "wall_s": 4.0, "views_per_s": 17.5},
+    ]
+    record = {"measure": "generate", "stamp": stamp, "commands": [["x"]], "result": runs}
+    (out / "generate.json").write_text(json.dumps(record))
+    older = tmp_path / "older.md"
+    older.write_text("# Old\n\n## A section\n\nMeasured at `abc1234`: 3 views/s.\n")
+
+    doc = suite.page(out, older=older)
+    dirty = " with uncommitted changes" if stamp["dirty"] else ""
+    assert f"at commit `{stamp['commit'][:10]}`{dirty} on {stamp['cores']} x {stamp['cpu']}" in doc
+    assert f"load average {stamp['load_average']:.2f} at the start" in doc
+    assert stamp["date"] in doc
+    assert f"| `{mini_dataset.name}` | {validate['result']['seconds']:.1f} |" in doc
+    result = channels["result"]
+    assert f"| channels / RGB only | {result['ratio']:.2f}x | >= 0.85x |" in doc
+    assert f"| PNG bytes per view, image | {result['bytes_per_view']['image']:,} |" in doc
+    assert "| **2 workers / 1** | 2.00x | >= 1.8x |" in doc
+    assert "| **Ray local / local pool** | 0.88x | >= 0.8x |" in doc
+    # what was not measured is listed with its command; the older page is fingerprinted
+    assert "## Not measured in this set" in doc
+    assert "`python bench/suite.py run OUT --extras fuzz`" in doc
+    assert (
+        "## Rendering" not in doc and "`bench/render.py`): `python bench/suite.py run OUT`" in doc
+    )
+    digest = hashlib.sha256(older.read_bytes()).hexdigest()
+    assert f"sha256 `{digest[:16]}…`" in doc and "`abc1234`" in doc and "A section" in doc
+    # the figures change with the files, not with the template
+    runs[1]["views_per_s"] = 30.0
+    (out / "generate.json").write_text(json.dumps(record))
+    assert "| **2 workers / 1** | 3.00x |" in suite.page(out, older=older)
