@@ -70,8 +70,8 @@ ABLATIONS = ("seannet", "seannet-image", "seannet-nolayout", "seannet-graph")
 BOXES = ("seannet+boxes", "seannet")
 # a learned scene term against the hand-made overlap, on both networks
 KERNEL = ("seannet+box-kernel", "resnet18+boxes", "seannet+boxes", "resnet18+box-kernel")
-# the GCN fc 512 wide instead of the paper's 4,096: a CPU step near ResNet-18's; under the
-# same budget it trains more batches (docs/benchmarks.md)
+# the GCN fc 512 wide instead of the paper's 4,096: a CPU step near ResNet-18's (what each
+# got under the same budget: the fc section's budget table)
 FC = ("seannet-fc512", "seannet")
 COMPARISONS = {
     "headline": HEADLINE,
