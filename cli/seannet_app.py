@@ -340,7 +340,6 @@ def train_navigator_command(
     """Train the visual navigator (forward / left / right) on pairs rendered from the rooms."""
     from rich.progress import Progress
 
-    from seannet.navigation.navigator import NavigatorConfig
     from seannet.navigation.navigator_training import train_navigator
 
     config = NavigatorConfig(

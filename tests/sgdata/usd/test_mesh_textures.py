@@ -76,6 +76,7 @@ def test_images_are_usdshade_textures_on_the_files_uvs(written: tuple) -> None:
     mesh = UsdGeom.Mesh(plate_prim.GetChild("Geom"))
     st = np.array(UsdGeom.PrimvarsAPI(mesh).GetPrimvar("st").ComputeFlattened())
     uvs = class_assets(catalog["Plate"])[0].face_uvs
+
     # every face is textured with the file's coordinates (faces grouped by part: sort them)
     def rows(a: np.ndarray) -> np.ndarray:
         flat = np.round(np.asarray(a, np.float64).reshape(-1, 6), 5)
