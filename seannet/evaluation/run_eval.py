@@ -149,8 +149,9 @@ def evaluate_run(
         save_png(
             draw_heatmap(stats["std"], f"{name}: std S by offset"), out / f"heat_std_{split}.png"
         )
-    atomic_write_text(out / f"eval_{split}{tag}.json", json.dumps(result, indent=2))
-    atomic_write_text(out / f"eval_{split}{tag}.md", _markdown(result))
+    written = eval_file(out, split, boxes=boxes, noise=noise)
+    atomic_write_text(written, json.dumps(result, indent=2))
+    atomic_write_text(written.with_suffix(".md"), _markdown(result))
     return result
 
 

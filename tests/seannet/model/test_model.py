@@ -234,7 +234,11 @@ def test_batch_to_device_keeps_values() -> None:
     moved = batch.to("cpu")
     assert moved is not batch
     for k, v in vars(batch).items():  # the tensors, and mean / std (None: float images)
-        assert torch.equal(getattr(moved, k), v) if v is not None else getattr(moved, k) is None
+        if isinstance(v, dict):  # the channels, by name (none asked here)
+            assert getattr(moved, k).keys() == v.keys()
+            assert all(torch.equal(getattr(moved, k)[c], v[c]) for c in v)
+        else:
+            assert torch.equal(getattr(moved, k), v) if v is not None else getattr(moved, k) is None
 
 
 def test_factory_checks_names_and_word_vectors() -> None:

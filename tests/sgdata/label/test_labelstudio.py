@@ -274,13 +274,13 @@ def test_cli_export_then_import(tmp_path: Path) -> None:
     assert "imported 10 box(es) and 3 relation(s) of 6 photo(s)" in imported.stdout
     assert _content(tmp_path / "again") == _content(first)
     bad = subprocess.run(
-        [*cli, "export", "coco", str(first), "-o", str(out)],
+        [*cli, "export", "bogus", str(first), "-o", str(out)],
         capture_output=True,
         text=True,
         timeout=120,
         env=env,
     )
-    assert bad.returncode == 2 and "expected labelstudio" in bad.stderr
+    assert bad.returncode == 2 and "expected one of coco, labelstudio, yolo" in bad.stderr
 
 
 ODD_NAMES = ["my cup #1.png", "what?.jpg", "100% tea.png", "tasse à café.jpg", "a b%20c.png"]

@@ -436,7 +436,10 @@ def test_a_format_1_1_dataset_reads_validates_and_migrates(copy: Path, mini_data
     migrated = {f.path: f.sha256 for f in manifest.files}
     assert migrated == generated  # the very bytes generate writes: tables, card, croissant
     assert (copy / "dataset.json").read_bytes() == (mini_dataset / "dataset.json").read_bytes()
-    assert migrate_dataset(copy) == manifest  # a current dataset: nothing changes
+    before = {p.name: p.read_bytes() for p in copy.iterdir() if p.is_file()}
+    again = migrate_dataset(copy)  # a current dataset: nothing changes, to the byte
+    assert {p.name: p.read_bytes() for p in copy.iterdir() if p.is_file()} == before
+    assert again.files == manifest.files and again.format_version == manifest.format_version
     done = subprocess.run([*cli, str(copy / "scenes")], capture_output=True, text=True)
     assert done.returncode != 0 and "no dataset.json" in done.stderr
     assert len(done.stderr.strip().splitlines()) == 1
