@@ -9,7 +9,7 @@ step and call, and runs each step:
 
 - ``headline``: ``seannet compare`` of SeanNet, ``resnet18+boxes`` and ResNet-18, 3 seeds,
   lr from {0.003, 0.01} on val, ``--budget`` seconds of one thread's compute per run (300:
-  about the 150 s of runs made before 2026-12-03; the protocol: selection.json before test);
+  about the 150 s of runs made before 2026-12-02; the protocol: selection.json before test);
 - ``noise``: the headline models' chosen runs evaluated on test under labeler / detector box
   noise (every choice, epsilon and lambda, re-read on val under the same noise);
 - ``ablations``: SeanNet's image branch alone, the paper's graph branch (no layout pathway)
@@ -242,7 +242,7 @@ def _budget(result: dict[str, Any]) -> str:
             "from its timed steps; what each got: below)"
         )
     return (
-        f"{seconds:g} s per run as budgets were timed before 2026-12-03 (process CPU over "
+        f"{seconds:g} s per run as budgets were timed before 2026-12-02 (process CPU over "
         "torch's threads, which load changes; what each got: not recorded)"
     )
 
@@ -307,7 +307,7 @@ def _budget_lines(runs: Path, result: dict[str, Any]) -> list[str]:
         said = (
             f"Like for like not shown: {', '.join(unknown)} "
             f"{'has' if len(unknown) == 1 else 'have'} no budget record (runs made before "
-            "budgets were recorded, 2026-12-03), so the batches cannot be told to come from "
+            "budgets were recorded, 2026-12-02), so the batches cannot be told to come from "
             "one rule."
         )
     elif len(set(rules.values())) == 1:

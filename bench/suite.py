@@ -54,7 +54,7 @@ from sgdata.fileio import atomic_write_text  # noqa: E402
 PY = sys.executable
 PAGE = ROOT / "docs" / "benchmarks.md"
 # the hand-assembled page this generator replaced: its figures, each naming its commit
-OLDER = ROOT / "docs" / "benchmarks-2026-12-03.md"
+OLDER = ROOT / "docs" / "benchmarks-2026-12-02.md"
 CORE = ("render", "generate", "loader", "validate")
 EXTRAS = ("channels", "assets", "fuzz")
 # the ratios the project holds itself to (issue 25): aims, not measurements

@@ -5,7 +5,7 @@ The code's state is read once, when ``seannet`` is first imported (:data:`PROCES
 made while a long run goes on does not change what its records say. Each call of
 :func:`append_provenance` adds one JSON line, so a directory that several commands or several
 calls wrote into names every one of them, and a generated document can say which runs made
-its tables (:func:`read_provenance`, :func:`stamp`). Directories written before 2026-12-03
+its tables (:func:`read_provenance`, :func:`stamp`). Directories written before 2026-12-02
 hold one ``provenance.json`` or ``provenance-<step>.json`` each; they are read too.
 """
 
@@ -139,7 +139,7 @@ def read_provenance(
     directory: Path, step: str | None = None, *, legacy: str | None = None
 ) -> list[dict[str, Any]]:
     """Every record of ``directory`` (of ``step`` when given), oldest first: the one record of
-    a directory written before 2026-12-03 (``legacy``, by default ``provenance.json`` or
+    a directory written before 2026-12-02 (``legacy``, by default ``provenance.json`` or
     ``provenance-<step>.json``) first, then ``provenance.jsonl``'s lines (a torn last line,
     from a killed process, is skipped)."""
     legacy = legacy or ("provenance.json" if step is None else f"provenance-{step}.json")

@@ -1,6 +1,6 @@
 """Deprecated: ``seannet.evaluation.eval`` moved to :mod:`seannet.evaluation.run_eval` (its
 ``SCENE_TERMS`` and ``scene_term`` to :mod:`seannet.model.specs`). Kept as an alias for one
-release (CHANGELOG 2026-12-03)."""
+release (CHANGELOG 2026-12-02)."""
 
 import warnings
 from typing import Any

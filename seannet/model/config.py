@@ -81,7 +81,7 @@ class ModelConfig:
 
     def _apply_ablation_fields(self) -> None:
         """An ablation of :data:`~seannet.model.specs.ABLATION_FIELDS` sets its fields: a
-        field at the default takes the ablation's value (configs saved before 2026-12-03 named
+        field at the default takes the ablation's value (configs saved before 2026-12-02 named
         ``seannet-fc512`` with ``graph_hidden`` 4096 and built 512), another value is refused."""
         for field, value in ABLATION_FIELDS.get(self.name, {}).items():
             given = getattr(self, field)

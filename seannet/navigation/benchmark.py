@@ -172,7 +172,7 @@ def results_path(out: Path, split: str) -> Path:
 
 
 def _config(config: NavigationTestConfig | None, settings: dict[str, Any]) -> NavigationTestConfig:
-    """``config`` with the deprecated keyword settings of before 2026-12-03 applied."""
+    """``config`` with the deprecated keyword settings of before 2026-12-02 applied."""
     config = config if config is not None else NavigationTestConfig()
     if not settings:
         return config

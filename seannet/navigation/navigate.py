@@ -1,4 +1,4 @@
-"""A moved module, kept as an alias for one release (CHANGELOG 2026-12-03)."""
+"""A moved module, kept as an alias for one release (CHANGELOG 2026-12-02)."""
 
 import warnings
 from typing import Any

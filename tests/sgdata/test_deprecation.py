@@ -25,10 +25,11 @@ MOVED = [
 
 @pytest.mark.parametrize(("old", "name", "new", "new_name"), MOVED)
 def test_a_moved_name_imports_from_its_old_place_with_a_warning(
-    old: str, name: str, new: str, new_name: str
+    old: str, name: str, new: str, new_name: str, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    if old != new:  # a shim module warns when imported: import it afresh
-        sys.modules.pop(old, None)
+    if old != new:  # a shim module warns when imported: import it afresh, put back after
+        # (a second copy of a real module left behind would give other tests twin classes)
+        monkeypatch.delitem(sys.modules, old, raising=False)
     with pytest.warns(DeprecationWarning, match=new.replace(".", r"\.")):
         value = getattr(importlib.import_module(old), name)
     assert value is getattr(importlib.import_module(new), new_name)

@@ -82,14 +82,14 @@ def test_network_lookup_by_name_or_alias() -> None:
     assert set(SCENE_TERMS) == {"+boxes", "+box-kernel"}
 
 
-def test_old_names_import_with_a_deprecation_warning() -> None:
+def test_old_names_import_with_a_deprecation_warning(monkeypatch: pytest.MonkeyPatch) -> None:
     import seannet.weights as weights
 
     with pytest.warns(DeprecationWarning, match="NETWORKS"):
         assert weights.WEIGHTS is NETWORKS
     with pytest.warns(DeprecationWarning, match="NetworkRecord"):
         assert weights.WeightsRecord is weights.NetworkRecord
-    sys.modules.pop("seannet.evaluation.eval", None)
+    monkeypatch.delitem(sys.modules, "seannet.evaluation.eval", raising=False)
     with pytest.warns(DeprecationWarning, match="run_eval"):
         old = importlib.import_module("seannet.evaluation.eval")
     from seannet.evaluation.run_eval import evaluate_run
@@ -119,7 +119,7 @@ def test_an_ablation_of_a_config_field_stores_the_model_it_builds() -> None:
     saved = config.to_dict()
     assert saved["model"]["graph_hidden"] == 512
     assert TrainConfig.from_dict(saved).model == config.model
-    saved["model"]["graph_hidden"] = 4096  # what configs saved before 2026-12-03 said
+    saved["model"]["graph_hidden"] = 4096  # what configs saved before 2026-12-02 said
     assert TrainConfig.from_dict(saved).model.graph_hidden == 512
     # naming the paper's SeanNet gives its fc back; a width the ablation contradicts is refused
     assert config.replace(model="seannet").model.graph_hidden == 4096

@@ -1,4 +1,4 @@
-"""The navigation modules renamed on 2026-12-03 still import from their old paths, with a
+"""The navigation modules renamed on 2026-12-02 still import from their old paths, with a
 DeprecationWarning, for one release."""
 
 from __future__ import annotations
@@ -16,8 +16,8 @@ MOVED = {
 
 
 @pytest.mark.parametrize("old", sorted(MOVED))
-def test_old_path_warns_and_gives_the_same_names(old: str) -> None:
-    sys.modules.pop(old, None)
+def test_old_path_warns_and_gives_the_same_names(old: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.delitem(sys.modules, old, raising=False)  # import afresh, put back after
     with pytest.warns(DeprecationWarning, match=MOVED[old]):
         module = importlib.import_module(old)
     new = importlib.import_module(MOVED[old])
