@@ -21,6 +21,7 @@ from seannet.data.moved import BIN_NAMES, MOVED_BINS
 
 __all__ = [
     "recall_at_k",
+    "map_queries",
     "map_recall",
     "accuracy_by_moved",
     "separation",
@@ -45,25 +46,36 @@ def recall_at_k(sim: np.ndarray, truth: np.ndarray, ks: Sequence[int] = (1, 5)) 
     return {int(k): float((rank < k).mean()) for k in ks}
 
 
+def map_queries(
+    embeddings: Any, room: str, map_layout: int = 0
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A room's map and its queries: the map layout's view indices, the indices of the other
+    layouts' views whose pose the map holds, and each query's true map view (a position in
+    the map's indices)."""
+    e = embeddings
+    in_room = e.room == room
+    map_idx = np.nonzero(in_room & (e.layout == map_layout))[0]
+    pose_of = {(e.grid_i[k], e.grid_j[k], e.heading[k]): n for n, k in enumerate(map_idx)}
+    queries = [
+        (k, pose_of[(e.grid_i[k], e.grid_j[k], e.heading[k])])
+        for k in np.nonzero(in_room & (e.layout != map_layout))[0]
+        if (e.grid_i[k], e.grid_j[k], e.heading[k]) in pose_of
+    ]
+    q = np.array([k for k, _ in queries], dtype=np.int64)
+    return map_idx, q, np.array([t for _, t in queries], dtype=np.int64)
+
+
 def map_recall(embeddings: Any, *, map_layout: int = 0, ks: Sequence[int] = (1, 5)) -> dict:
     """recall@k of the same pose among the map layout's views, queries from other layouts."""
     sims, truths, rooms, map_views = [], [], [], {}
     e = embeddings
     for room in sorted(set(e.room)):
-        in_room = e.room == room
-        map_idx = np.nonzero(in_room & (e.layout == map_layout))[0]
+        map_idx, q, truth = map_queries(e, room, map_layout)
         map_views[room] = int(len(map_idx))
-        pose_of = {(e.grid_i[k], e.grid_j[k], e.heading[k]): n for n, k in enumerate(map_idx)}
-        queries = [
-            (k, pose_of[(e.grid_i[k], e.grid_j[k], e.heading[k])])
-            for k in np.nonzero(in_room & (e.layout != map_layout))[0]
-            if (e.grid_i[k], e.grid_j[k], e.heading[k]) in pose_of
-        ]
-        if not queries:
+        if not len(q):
             continue
-        q = np.array([k for k, _ in queries])
         sims.append(e.vectors[q] @ e.vectors[map_idx].T)
-        truths.append(np.array([t for _, t in queries]))
+        truths.append(truth)
         rooms.append(room)
     per_room = {r: recall_at_k(s, t, ks) for r, s, t in zip(rooms, sims, truths, strict=True)}
     queries = sum(len(t) for t in truths)

@@ -46,6 +46,7 @@ from seannet.data.box_noise import BoxNoise
 from seannet.data.datasets import ImageTransform, ObservationDataset, collate_views, open_dataset
 from seannet.errors import MethodError
 from seannet.evaluation.intervals import per_room_matrix, t_interval, two_level_interval
+from seannet.evaluation.retrieval import map_queries
 from seannet.methods.change import change_of_pairs, sweep
 from seannet.methods.checks import checked_similarity, checked_vectors, guarded
 from seannet.methods.registry import load_method
@@ -208,22 +209,14 @@ def _recall(h: _Harness, e: _Embedded, map_layout: int) -> dict[str, Any]:
     and each query's hit@1 with its (query, true map view) pair, for the change sweep."""
     ranks, pairs = [], []
     for room in sorted(set(e.room)):
-        in_room = e.room == room
-        map_idx = np.nonzero(in_room & (e.layout == map_layout))[0]
-        pose_of = {(e.grid_i[k], e.grid_j[k], e.heading[k]): n for n, k in enumerate(map_idx)}
-        queries = [
-            (k, pose_of[(e.grid_i[k], e.grid_j[k], e.heading[k])])
-            for k in np.nonzero(in_room & (e.layout != map_layout))[0]
-            if (e.grid_i[k], e.grid_j[k], e.heading[k]) in pose_of
-        ]
-        if not queries:
+        map_idx, q, truth = map_queries(e, room, map_layout)
+        if not len(q):
             continue
-        q, truth = np.array([k for k, _ in queries]), np.array([t for _, t in queries])
         first, second = np.repeat(q, len(map_idx)), np.tile(map_idx, len(q))
         sim = h.scores(e.vectors, first, second).reshape(len(q), len(map_idx))
         true_score = sim[np.arange(len(q)), truth]
         ranks.append((sim >= true_score[:, None]).sum(axis=1) - 1)  # ties count against
-        pairs += [(e.obs_ids[k], e.obs_ids[map_idx[t]]) for k, t in queries]
+        pairs += [(e.obs_ids[k], e.obs_ids[map_idx[t]]) for k, t in zip(q, truth, strict=True)]
     rank = np.concatenate(ranks) if ranks else np.zeros(0, np.int64)
     return {
         "recall": {k: float((rank < k).mean()) if len(rank) else float("nan") for k in (1, 5)},
