@@ -20,8 +20,7 @@ from seannet.data.datasets import ImageTransform, ObservationDataset, TripletDat
 from seannet.data.moved import moved_objects
 from seannet.data.opening import DataSource, open_dataset
 from seannet.errors import DataError
-from seannet.evaluation.box_kernel import SlotPairs, fit_box_kernel, slot_pairs
-from seannet.evaluation.box_overlap import SlotBoxes, choose_box_weight
+from seannet.evaluation.box_overlap import SlotBoxes
 from seannet.evaluation.embedding_cache import cached_embeddings
 from seannet.evaluation.metrics import (
     MAX_OFFSET,
@@ -37,7 +36,7 @@ from seannet.evaluation.metrics import (
     triplet_similarities,
 )
 from seannet.evaluation.retrieval import accuracy_by_moved, map_recall, separation
-from seannet.model.specs import SCENE_TERMS
+from seannet.evaluation.scene_term import BOX_KERNEL, SceneTerm
 from seannet.training.runs import MODEL_KEYS, restore_run
 from sgdata.dataset import Dataset
 from sgdata.errors import SgdataError
@@ -64,19 +63,20 @@ def evaluate_run(
     the same box noise as ``split``; the split evaluated only gives figures.
 
     Args:
-        boxes: a scene term of :data:`SCENE_TERMS` (``""``: none): score pairs
+        boxes: a scene term of :data:`~seannet.model.specs.SCENE_TERMS` (``""``: none): score pairs
             ``S + lambda * S_scene``, lambda chosen on val (``+boxes``: the hand-made overlap;
-            ``+box-kernel``: the kernel learned on train). Tagged with the term's name.
+            ``+box-kernel``: the kernel learned on train; :class:`SceneTerm`). Tagged with the
+            term's name.
         noise: evaluate with the boxes a labeler or detector would give (:class:`BoxNoise`).
             Tag ``_S<jitter>-P<drop>-Q<spurious>``.
 
     Raises:
+        ValueError: ``boxes`` is not a scene term.
         CheckpointError: no checkpoint, or it was trained on another dataset.
         DataError: the dataset or split is missing; ``boxes`` on a dataset with no val split,
             ``+box-kernel`` on one with no train split.
     """
-    if boxes and boxes not in SCENE_TERMS:
-        raise ValueError(f"boxes={boxes!r}: expected one of {', '.join(SCENE_TERMS)} or ''")
+    scene = SceneTerm.from_spec(boxes)  # a bad name fails before the run is read
     out = out or run
     ds = open_dataset(data)
     # photos: another dataset by design, but the same vocabulary
@@ -95,7 +95,6 @@ def evaluate_run(
     if "val" in ds.splits:
         val = evaluated if split == "val" else embedded("val")
     name, tag = config.model.name + boxes, _tag(boxes, noise)
-    choices: dict[str, Any] = {}
     if boxes:
         if val is None:
             raise DataError(
@@ -104,14 +103,12 @@ def evaluate_run(
         val_triplets = (
             triplets if split == "val" else TripletDataset(ds, "val", transform=transform)
         )
-        scene = _SceneScores(boxes, ds, noise)
-        choices.update(scene.fit)
+        if scene.learned:
+            scene.fit(*_train_boxes(ds, noise))
         v_ap, v_an = triplet_similarities(val, val_triplets)
-        b_ap, b_an = scene.triplets(val, val_triplets)
-        weight, by_weight = choose_box_weight(v_ap, v_an, b_ap, b_an)
-        o_ap, o_an = scene.triplets(evaluated, triplets)
-        s_ap, s_an = s_ap + weight * o_ap, s_an + weight * o_an
-        choices["box_weight"] = {"lambda": weight, "val_accuracy_by_lambda": by_weight}
+        scene.choose_weight(v_ap, v_an, *scene.triplet_scores(_boxes(val), val_triplets.obs))
+        o_ap, o_an = scene.triplet_scores(_boxes(evaluated), triplets.obs)
+        s_ap, s_an = scene.combine(s_ap, o_ap), scene.combine(s_an, o_an)
     metrics = triplet_metrics(triplets, s_ap, s_an)
     moved = moved_objects(ds, split, triplets.obs)
     if val is not None:
@@ -128,7 +125,7 @@ def evaluate_run(
         "split": split,
         "epoch": state["epoch"],
         "noise": asdict(noise) if noise is not None else None,
-        **choices,
+        **scene.choices,  # the kernel fit on train, lambda on val
         **metrics,
         # epsilon, retrieval and the offset statistics read the embedding alone
         "threshold": {**threshold, "rule": rule},
@@ -167,43 +164,19 @@ def _tag(boxes: str, noise: BoxNoise | None) -> str:
     return tag
 
 
-class _SceneScores:
-    """``S_scene(A, P)`` and ``S_scene(A, N)`` of triplets, from the boxes the model saw:
-    the hand-made overlap, or the kernel fit on the train triplets' boxes (same noise)."""
+def _boxes(embeddings: Embeddings) -> SlotBoxes:
+    """The boxes the model saw in every view of ``embeddings``, by slot."""
+    assert embeddings.slot_boxes is not None  # embed_split always fills it
+    return SlotBoxes(embeddings.obs_ids, *embeddings.slot_boxes, embeddings.num_slots)
 
-    def __init__(self, term: str, ds: Dataset, noise: BoxNoise | None) -> None:
-        self.kernel = None
-        self.fit: dict[str, Any] = {}
-        if term == "+box-kernel":
-            if "train" not in ds.splits:
-                raise DataError(
-                    f"{ds.root}: +box-kernel learns on the train split, and there is none"
-                )
-            views = ObservationDataset(ds, "train", noise=noise)
-            boxes = SlotBoxes(views.obs_ids, *views.slot_boxes(), views.num_slots)
-            positive, negative = self._pairs(boxes, TripletDataset(ds, "train").obs)
-            self.kernel, accuracy = fit_box_kernel(positive, negative, views.num_slots)
-            self.fit = {
-                "box_kernel": {"train_triplets": positive.pairs, "train_accuracy": accuracy}
-            }
 
-    @staticmethod
-    def _pairs(boxes: SlotBoxes, obs: list[tuple[str, str, str]]) -> tuple[SlotPairs, SlotPairs]:
-        anchors, positives, negatives = zip(*obs, strict=True) if obs else ((), (), ())
-        return slot_pairs(boxes, anchors, positives), slot_pairs(boxes, anchors, negatives)
-
-    def triplets(
-        self, embeddings: Embeddings, triplets: TripletDataset
-    ) -> tuple[np.ndarray, np.ndarray]:
-        assert embeddings.slot_boxes is not None  # embed_split always fills it
-        boxes = SlotBoxes(embeddings.obs_ids, *embeddings.slot_boxes, embeddings.num_slots)
-        if self.kernel is None:
-            anchors, positives, negatives = (
-                zip(*triplets.obs, strict=True) if triplets.obs else ((), (), ())
-            )
-            return boxes.overlap(anchors, positives), boxes.overlap(anchors, negatives)
-        positive, negative = self._pairs(boxes, triplets.obs)
-        return self.kernel.score(positive), self.kernel.score(negative)
+def _train_boxes(ds: Dataset, noise: BoxNoise | None) -> tuple[SlotBoxes, list]:
+    """The train split's boxes (under ``noise``) and triplets, for ``+box-kernel``'s fit."""
+    if "train" not in ds.splits:
+        raise DataError(f"{ds.root}: {BOX_KERNEL} learns on the train split, and there is none")
+    views = ObservationDataset(ds, "train", noise=noise)
+    boxes = SlotBoxes(views.obs_ids, *views.slot_boxes(), views.num_slots)
+    return boxes, TripletDataset(ds, "train").obs
 
 
 def _all_real(ds: Dataset, split: str) -> bool:

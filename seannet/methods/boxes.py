@@ -1,5 +1,6 @@
 """Boxes in a method's vectors: every slot's box as 4 numbers (-1 where the slot is empty),
-scored by the hand-made overlap or a slot kernel learned on triplets."""
+scored by a scene term (:class:`~seannet.evaluation.scene_term.SceneTerm`: the hand-made
+overlap or a slot kernel learned on triplets)."""
 
 from __future__ import annotations
 
@@ -7,10 +8,10 @@ import numpy as np
 import torch
 from torch import Tensor
 
-from seannet.evaluation.box_kernel import BoxKernel, fit_box_kernel, slot_pairs
 from seannet.evaluation.box_overlap import SlotBoxes
+from seannet.evaluation.scene_term import SceneTerm
 
-__all__ = ["ABSENT", "box_scores", "box_vectors", "fit_kernel", "triplet_box_scores"]
+__all__ = ["ABSENT", "box_scores", "box_vectors", "row_triplets", "vector_boxes"]
 
 ABSENT = -1.0  # a slot's four numbers when the view has no object in it
 
@@ -20,40 +21,26 @@ def box_vectors(slot_boxes: Tensor) -> Tensor:
     return torch.nan_to_num(slot_boxes, nan=ABSENT).flatten(1)
 
 
-def _slot_boxes(a: np.ndarray, b: np.ndarray) -> tuple[SlotBoxes, list[str], list[str]]:
-    """Two (P, 4 M) box-vector arrays as one :class:`SlotBoxes` and the ids of each side."""
-    both = np.concatenate([a, b]).astype(np.float32).reshape(len(a) + len(b), -1, 4)
-    both[both[..., 0] == ABSENT] = np.nan
-    view, slot = np.nonzero(~np.isnan(both[..., 0]))
-    offsets = np.concatenate([[0], np.cumsum(np.bincount(view, minlength=len(both)))])
-    ids = [str(k) for k in range(len(both))]
-    boxes = SlotBoxes(ids, offsets, slot, both[view, slot], both.shape[1])
-    return boxes, ids[: len(a)], ids[len(a) :]
+def vector_boxes(vectors: Tensor | np.ndarray) -> SlotBoxes:
+    """(N, 4 M) box vectors as :class:`SlotBoxes` whose ids are the row numbers as text
+    (``"0"``, ``"1"``, ...: :func:`row_triplets`)."""
+    if isinstance(vectors, Tensor):
+        vectors = vectors.detach().cpu().numpy()
+    boxes = np.asarray(vectors, dtype=np.float32).reshape(len(vectors), -1, 4).copy()
+    boxes[boxes[..., 0] == ABSENT] = np.nan
+    view, slot = np.nonzero(~np.isnan(boxes[..., 0]))
+    offsets = np.concatenate([[0], np.cumsum(np.bincount(view, minlength=len(boxes)))])
+    ids = [str(k) for k in range(len(boxes))]
+    return SlotBoxes(ids, offsets, slot, boxes[view, slot], boxes.shape[1])
 
 
-def box_scores(a: Tensor, b: Tensor, kernel: BoxKernel | None = None) -> Tensor:
-    """(P,) scores in [0, 1] of row pairs of box vectors: the mean IoU over the slots present
-    in either view (:class:`~seannet.evaluation.box_overlap.SlotBoxes`), or the kernel's."""
-    boxes, first, second = _slot_boxes(a.detach().cpu().numpy(), b.detach().cpu().numpy())
-    if kernel is None:
-        return torch.from_numpy(boxes.overlap(first, second)).float()
-    return torch.from_numpy(kernel.score(slot_pairs(boxes, first, second))).float()
+def row_triplets(triplets: np.ndarray) -> list[tuple[str, str, str]]:
+    """(T, 3) row-index triplets as the ids of :func:`vector_boxes`."""
+    return [(str(a), str(p), str(n)) for a, p, n in np.asarray(triplets).tolist()]
 
 
-def triplet_box_scores(
-    vectors: Tensor, triplets: np.ndarray, kernel: BoxKernel | None = None
-) -> tuple[np.ndarray, np.ndarray]:
-    """(S_box(A, P), S_box(A, N)) of (T, 3) triplets over rows of ``vectors``."""
-    a, p, n = (vectors[torch.from_numpy(triplets[:, k])] for k in range(3))
-    return box_scores(a, p, kernel).double().numpy(), box_scores(a, n, kernel).double().numpy()
-
-
-def fit_kernel(vectors: Tensor, triplets: np.ndarray) -> tuple[BoxKernel, float]:
-    """A slot kernel fit on train triplets of box vectors, and its train accuracy."""
-    num_slots = vectors.shape[1] // 4
-    a, p, n = (vectors[torch.from_numpy(triplets[:, k])].numpy() for k in range(3))
-    boxes, first, second = _slot_boxes(a, p)
-    positive = slot_pairs(boxes, first, second)
-    boxes, first, second = _slot_boxes(a, n)
-    negative = slot_pairs(boxes, first, second)
-    return fit_box_kernel(positive, negative, num_slots)
+def box_scores(a: Tensor, b: Tensor, scene: SceneTerm) -> Tensor:
+    """(P,) float64 ``S_scene`` in [0, 1] of row pairs of box vectors (a[k], b[k])."""
+    boxes = vector_boxes(torch.cat([a.detach().cpu(), b.detach().cpu()]))
+    rows = [str(k) for k in range(len(a) + len(b))]
+    return torch.from_numpy(scene.scores(boxes, rows[: len(a)], rows[len(a) :]))

@@ -13,9 +13,9 @@ import torch.nn.functional as F
 from torch import Tensor
 
 from seannet.evaluation.box_kernel import BoxKernel
-from seannet.evaluation.box_overlap import choose_box_weight
 from seannet.evaluation.compare import model_spec
-from seannet.methods.boxes import box_scores, box_vectors, fit_kernel, triplet_box_scores
+from seannet.evaluation.scene_term import SceneTerm
+from seannet.methods.boxes import box_scores, box_vectors, row_triplets, vector_boxes
 from seannet.methods.views import Budget, SplitData, Views
 from seannet.model.specs import SEANNET, parse_spec
 from seannet.training.config import preset as load_preset
@@ -43,9 +43,10 @@ def pair_scores(method: object, vectors: Tensor, triplets: np.ndarray) -> tuple[
 
 class NetworkMethod:
     """A bundled network named by a model spec, trained by :func:`seannet.training.train` in
-    ``fit`` (the lr chosen on val among ``budget.lrs``; ``+boxes`` / ``+box-kernel``: lambda
-    chosen on val). Its vectors are the unit embedding, followed for a scene term by every
-    slot's box (the map holds them too: they count in its bytes per entry)."""
+    ``fit`` (the lr chosen on val among ``budget.lrs``; ``+boxes`` / ``+box-kernel``: the
+    :class:`~seannet.evaluation.scene_term.SceneTerm` ``seannet eval`` uses, its kernel fit on
+    train and lambda chosen on val). Its vectors are the unit embedding, followed for a scene
+    term by every slot's box (the map holds them too: they count in its bytes per entry)."""
 
     trainable = True
 
@@ -58,8 +59,7 @@ class NetworkMethod:
         self._configure(preset)
         self.model: torch.nn.Module | None = None
         self.device = torch.device("cpu")
-        self.box_weight = 0.0
-        self.kernel: BoxKernel | None = None
+        self.scene = SceneTerm.from_spec(self.parsed.scene)
         self.choices: dict[str, object] = {}
         self._dim = 0
 
@@ -78,6 +78,7 @@ class NetworkMethod:
         self._configure(budget.preset, **changes)
         spec = model_spec(self.name, self.config)
         work = budget.work or Path(tempfile.mkdtemp(prefix="seannet-method-"))
+        self.scene = SceneTerm.from_spec(self.parsed.scene)  # the lr is chosen on S alone
         by_lr: dict[str, float] = {}
         best: tuple[float, float, Path] | None = None
         for lr in budget.lrs or (self.config.lr,):
@@ -94,29 +95,46 @@ class NetworkMethod:
         assert best is not None
         self._restore(best[2], train_split.root)
         self.choices = {"lr": -best[1], "val_accuracy_by_lr": by_lr, "run": str(best[2])}
-        if self.parsed.scene == "+box-kernel":
-            self.kernel, accuracy = fit_kernel(self._boxes(train_split), train_split.triplets)
-            self.choices["box_kernel_train_accuracy"] = accuracy
-        if self.parsed.scene:
-            self._choose_weight(val)
+        if self.scene.term:
+            self.fit_scene(train_split, val)
+            self.choices.update(self.scene.choices)
 
     def _restore(self, run: Path, root: Path) -> None:
         restored = restore_run(run, root)
         self.model, self.device = restored.model, restored.device
 
-    def _boxes(self, split: SplitData) -> Tensor:
-        return torch.cat([box_vectors(v.slot_boxes()) for v in split.views()])
-
-    def _choose_weight(self, val: SplitData) -> None:
+    def fit_scene(self, train: SplitData, val: SplitData) -> None:
+        """The scene term's choices for the network as it stands: ``+box-kernel``'s kernel on
+        the train triplets' boxes, then lambda on the val triplets (``seannet eval``'s rule)."""
+        self.scene = SceneTerm.from_spec(self.parsed.scene)
+        if self.scene.learned:
+            boxes = torch.cat([box_vectors(v.slot_boxes()) for v in train.views()])
+            self.scene.fit(vector_boxes(boxes), row_triplets(train.triplets))
         vectors = embed_split_views(self, val)
         a, p, n = (vectors[torch.from_numpy(val.triplets[:, k]), : self._dim] for k in range(3))
         s_ap, s_an = (a * p).sum(1).double().numpy(), (a * n).sum(1).double().numpy()
-        b_ap, b_an = triplet_box_scores(vectors[:, self._dim :], val.triplets, self.kernel)
-        self.box_weight, by_weight = choose_box_weight(s_ap, s_an, b_ap, b_an)
-        self.choices["box_weight"] = {
-            "lambda": self.box_weight,
-            "val_accuracy_by_lambda": by_weight,
-        }
+        boxes = vector_boxes(vectors[:, self._dim :])
+        self.scene.choose_weight(
+            s_ap, s_an, *self.scene.triplet_scores(boxes, row_triplets(val.triplets))
+        )
+
+    @property
+    def box_weight(self) -> float:
+        """lambda, chosen on val (0 before :meth:`fit`)."""
+        return self.scene.weight
+
+    @property
+    def kernel(self) -> BoxKernel | None:
+        """``+box-kernel``'s kernel, fit on train (None before :meth:`fit` or for ``+boxes``)."""
+        return self.scene.kernel
+
+    def __setstate__(self, state: dict[str, object]) -> None:
+        # a method.pt pickled before the SceneTerm held box_weight and kernel itself
+        if "scene" not in state:
+            scene = SceneTerm(state["parsed"].scene, state.pop("kernel", None))  # type: ignore[attr-defined]
+            scene.weight = float(state.pop("box_weight", 0.0))  # type: ignore[arg-type]
+            state["scene"] = scene
+        self.__dict__.update(state)
 
     @torch.no_grad()
     def embed(self, views: Views) -> Tensor:
@@ -131,7 +149,7 @@ class NetworkMethod:
     def similarity(self, a: Tensor, b: Tensor) -> Tensor:
         d = self._dim
         s = (a[:, :d] * b[:, :d]).sum(1)
-        if not self.parsed.scene:
+        if not self.scene.weight:  # no scene term, or lambda 0 (or not chosen yet): S alone
             return s
-        boxes = box_scores(a[:, d:], b[:, d:], self.kernel).to(s.dtype)
-        return (s + self.box_weight * boxes) / (1.0 + self.box_weight)  # stays in [-1, 1]
+        boxes = box_scores(a[:, d:], b[:, d:], self.scene)
+        return self.scene.combine(s.double(), boxes, unit=True)  # stays in [-1, 1]

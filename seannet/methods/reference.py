@@ -21,7 +21,8 @@ import torch.nn.functional as F
 from torch import Tensor, nn
 
 from seannet.evaluation.box_kernel import BoxKernel
-from seannet.methods.boxes import box_scores, box_vectors, fit_kernel
+from seannet.evaluation.scene_term import BOX_KERNEL, SceneTerm
+from seannet.methods.boxes import box_scores, box_vectors, row_triplets, vector_boxes
 from seannet.methods.registry import register_method
 from seannet.methods.views import Budget, SplitData, Views
 from seannet.model.loss import TripletLoss
@@ -89,6 +90,7 @@ class Lite0GeMHead(Lite0GeM):
         super().__init__()
         self.head: nn.Module = nn.Identity()
         self.choices: dict[str, object] = {}
+        self.inputs = 0  # the frozen features' channels, the head's input
 
     def _pooled(self, split: SplitData) -> Tensor:
         """The frozen inputs of the head, every view of ``split`` in order."""
@@ -105,6 +107,7 @@ class Lite0GeMHead(Lite0GeM):
     def fit(self, train: SplitData, val: SplitData, budget: Budget) -> None:
         train_x, val_x = self._pooled(train), self._pooled(val)
         train_t, val_t = torch.from_numpy(train.triplets), torch.from_numpy(val.triplets)
+        self.inputs = int(train_x.shape[1])
         loss_fn = TripletLoss(margin=0.1)
         by_lr, best = {}, None
         for lr in budget.lrs or (0.01, 0.1):
@@ -125,6 +128,18 @@ class Lite0GeMHead(Lite0GeM):
         assert best is not None
         self.head = best[2].eval()
         self.choices = {"lr": -best[1], "val_accuracy_by_lr": by_lr}
+
+    def state_dict(self) -> dict:
+        """The trained head's weights and the choices on val (the trunk is ImageNet's)."""
+        head = {k: v.detach().cpu() for k, v in self.head.state_dict().items()}
+        return {"inputs": self.inputs, "head": head, "choices": self.choices}
+
+    def load_state_dict(self, state: dict) -> None:
+        self.inputs = int(state["inputs"])
+        self.head = self._new_head(torch.zeros(1, self.inputs))
+        self.head.load_state_dict(state["head"])
+        self.head.eval()
+        self.choices = dict(state["choices"])
 
     @torch.no_grad()
     def embed(self, views: Views) -> Tensor:
@@ -174,27 +189,52 @@ class Lite0NetVLAD(Lite0GeMHead):
 @register_method("boxes-overlap")
 class BoxOverlap:
     """Boxes only: each slot's box (image-relative), scored by the mean IoU over the slots
-    present in either view (:mod:`seannet.evaluation.box_overlap`)."""
+    present in either view (the scene term ``+boxes`` alone:
+    :class:`~seannet.evaluation.scene_term.SceneTerm`)."""
 
     uses_boxes = True
     image_size = 64  # the pixels are not read; the boxes are scaled with them
-    kernel: BoxKernel | None = None
+    term = "+boxes"
+
+    def __init__(self) -> None:
+        self.scene = SceneTerm.from_spec(self.term)
+
+    @property
+    def kernel(self) -> BoxKernel | None:
+        """The slot kernel (``boxes-kernel``, after ``fit``), else None."""
+        return self.scene.kernel
+
+    def __setstate__(self, state: dict[str, object]) -> None:
+        # a method.pt pickled before the SceneTerm held the kernel itself
+        if "scene" not in state:
+            kernel = state.pop("kernel", None)
+            state["scene"] = SceneTerm(self.term, kernel)  # type: ignore[arg-type]
+        self.__dict__.update(state)
 
     def embed(self, views: Views) -> Tensor:
         return box_vectors(views.slot_boxes())
 
     def similarity(self, a: Tensor, b: Tensor) -> Tensor:
-        return box_scores(a, b, self.kernel)
+        return box_scores(a, b, self.scene).float()  # float32, as the cards were computed
 
 
 @register_method("boxes-kernel")
 class BoxKernelMethod(BoxOverlap):
     """Boxes only, scored by a per-slot weighted IoU learned on the train triplets
-    (:mod:`seannet.evaluation.box_kernel`)."""
+    (the scene term ``+box-kernel`` alone: :mod:`seannet.evaluation.box_kernel`)."""
 
     trainable = True
+    term = BOX_KERNEL
 
     def fit(self, train: SplitData, val: SplitData, budget: Budget) -> None:
         torch.manual_seed(budget.seed)
         vectors = torch.cat([self.embed(v) for v in train.views()])
-        self.kernel, _ = fit_kernel(vectors, train.triplets)
+        self.scene = SceneTerm.from_spec(self.term)
+        self.scene.fit(vector_boxes(vectors), row_triplets(train.triplets))
+
+    def state_dict(self) -> dict:
+        """The fitted kernel as tensors and plain data (a card directory's ``method.pt``)."""
+        return {"scene": self.scene.state_dict()}
+
+    def load_state_dict(self, state: dict) -> None:
+        self.scene = SceneTerm.from_state(state["scene"])
