@@ -1,0 +1,52 @@
+"""bench/learning_curve.py on the mini dataset with tiny networks: a larger budget trains the
+first budget's batches scaled, at the lr chosen on val there, and the page is the runs'."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from seannet.training.config import TrainConfig
+
+from ..bench_scripts import load_bench
+
+
+def test_curve_scales_the_first_budget_and_writes_the_runs(
+    tmp_path: Path, mini_dataset: Path, tiny_seannet: TrainConfig
+) -> None:
+    curve = load_bench("learning_curve")
+    runs = tmp_path / "runs"
+    budgets = curve.parse_budgets("0.2:2,0.05:2,0.8:1")  # sorted: 0.05 first
+    assert [b for b, _ in budgets] == [0.05, 0.2, 0.8]
+    curve.run(mini_dataset, runs, budgets, ("seannet", "seannet+boxes"), preset=tiny_seannet)
+
+    points = curve.read_curve(runs)
+    assert list(points) == ["seannet", "seannet+boxes"]
+    first, middle, last = points["seannet"]
+    assert (first["seeds"], middle["seeds"], last["seeds"]) == (2, 2, 1)
+    # the first budget's calibrated batches, scaled by the budget: no second timing
+    assert middle["batches_per_epoch"] == max(1, round(first["batches_per_epoch"] * 4))
+    assert last["batches_per_epoch"] == max(1, round(first["batches_per_epoch"] * 16))
+    assert middle["lr"] == last["lr"] == first["lr"]  # chosen on val at the first budget
+    rows = json.loads((runs / "b0.8" / curve.CURVE).read_text())["runs"]
+    assert {Path(r["run"]).parent.parent.parent for r in rows} == {runs / "b0.8"}
+    # the boxes row is the same network's runs (its lr chosen on val with the boxes)
+    assert {Path(r["run"]).parent.parent.name for r in rows} == {"seannet"}
+
+    page = tmp_path / "docs" / "curve.md"
+    page.parent.mkdir()
+    text = curve.tables(runs, page.with_suffix(".png"))
+    assert page.with_suffix(".png").stat().st_size > 1000
+    assert "bench/learning_curve.py" in text and "commit" in text  # stamped
+    assert f"{100 * last['test']['mean']:.1f} (1 seed)" in text
+    assert f"{100 * first['val']['mean']:.1f} ± {100 * first['val']['ci95']:.1f}" in text
+
+
+def test_budgets_are_refused_with_one_line() -> None:
+    curve = load_bench("learning_curve")
+    with pytest.raises(SystemExit, match="expected BUDGET:SEEDS"):
+        curve.parse_budgets("300,1200")
+    with pytest.raises(SystemExit, match="seeds >= 1"):
+        curve.parse_budgets("300:0")
