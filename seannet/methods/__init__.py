@@ -1,7 +1,8 @@
 """Stage 5, methods: the public interface any localization method plugs into (``embed(views)``;
-optional ``similarity``, ``fit``, ``uses_boxes``), its registry (a decorator, an import path,
-the entry-point group ``seannet.methods``), the bundled networks and reference methods as
-methods, and ``seannet benchmark`` / ``seannet leaderboard`` (docs/benchmark.md)."""
+optional ``similarity``, ``fit`` with ``state_dict`` / ``load_state_dict``, ``uses_boxes``), its
+registry (a decorator, an import path, the entry-point group ``seannet.methods``), the bundled
+networks and reference methods as methods, and ``seannet benchmark`` / ``seannet leaderboard``
+(docs/benchmark.md)."""
 
 from sgdata.lazy_face import lazy_face
 

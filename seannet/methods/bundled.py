@@ -153,3 +153,50 @@ class NetworkMethod:
             return s
         boxes = box_scores(a[:, d:], b[:, d:], self.scene)
         return self.scene.combine(s.double(), boxes, unit=True)  # stays in [-1, 1]
+
+    def state_dict(self) -> dict:
+        """The fitted network as tensors and plain data (what ``method.pt`` keeps): its config,
+        the sizes its model was built with, the model's weights, the scene term (lambda, the
+        kernel's weights, its choices) and the choices made on val."""
+        if self.model is None:
+            raise RuntimeError(f"{self.name}: fit() first (a bundled network is trained)")
+        model = self.model.state_dict()
+        words = model.get("objects.word_vectors")  # SeanNet's classes; the baselines have none
+        return {
+            "spec": self.name,
+            "config": self.config.to_dict(),
+            "num_slots": getattr(self.model, "num_slots", None),
+            "classes": None if words is None else int(words.shape[0]),
+            "model": {k: v.detach().cpu() for k, v in model.items()},
+            "scene": self.scene.state_dict(),
+            "choices": self.choices,
+            "dim": self._dim,
+        }
+
+    def load_state_dict(self, state: dict) -> None:
+        """Rebuild the fitted network :meth:`state_dict` describes, in any interpreter."""
+        from seannet.model.factory import build_model
+        from seannet.model.wordvectors import WordVectorTable
+        from seannet.training.config import TrainConfig
+        from seannet.training.runs import device_for_run
+
+        if state.get("spec") != self.name:
+            raise ValueError(f"a state of {state.get('spec')!r}, not of {self.name!r}")
+        self.config = TrainConfig.from_dict(state["config"])
+        self.image_size = self.config.model.image_size
+        self.network = self.config.model.image_family
+        sizes: dict = {}
+        if state["num_slots"] is not None:
+            sizes["num_slots"] = int(state["num_slots"])
+        if state["classes"] is not None:  # SeanNet: its word vectors come with its weights
+            names = tuple(f"class{k}" for k in range(state["classes"]))
+            words = state["model"]["objects.word_vectors"].numpy()
+            sizes["word_vectors"] = WordVectorTable(names, words, "method state", "")
+            sizes["class_names"] = list(names)
+        model = build_model(self.config.model, **sizes)
+        model.load_state_dict(state["model"])
+        self.device = device_for_run()
+        self.model = model.to(self.device).eval()
+        self.scene = SceneTerm.from_state(state["scene"])
+        self.choices = dict(state["choices"])
+        self._dim = int(state["dim"])

@@ -6,9 +6,13 @@ A method reaches them three ways (:func:`open_method`):
 - by **name** (``tiny-image``, ``path/file.py:Make``, an entry point): a method with no
   ``fit``; its threshold epsilon is given (``--epsilon``);
 - by a **method directory**: ``method.json`` (its name, the epsilon chosen on val and the
-  dataset it was fit on) and, for a trained method, ``method.pt`` (the fitted object).
-  ``seannet benchmark`` writes one into every card directory, so a card directory names any
-  benchmarked method, the trained ones included (:func:`save_method`);
+  dataset it was fit on) and, for a trained method, ``method.pt``: ``{"format": 2, "state":
+  method.state_dict()}``, tensors and plain data only (``torch.load(weights_only=True)``
+  opens it). Opening one builds the method with its factory (the name in ``method.json``)
+  and hands it ``load_state_dict(state)``, so nothing of the method's class is pickled and a
+  fresh interpreter opens it. ``seannet benchmark`` writes one into every card directory, so
+  a card directory names any benchmarked method, the trained ones included
+  (:func:`save_method`);
 - a trained run directory (``best.pt``) is a bundled method too: :mod:`seannet.navigation`
   opens it as before.
 
@@ -22,6 +26,8 @@ import hashlib
 import io
 import json
 import math
+import pickle
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -40,11 +46,22 @@ from seannet.methods.views import Views
 from seannet.training.runs import MODEL_KEYS
 from sgdata.fileio import atomic_write_bytes, atomic_write_text
 
-__all__ = ["METHOD_FILE", "STATE_FILE", "MethodLocalizer", "open_method", "save_method"]
+__all__ = [
+    "METHOD_FILE",
+    "STATE_FILE",
+    "STATE_FORMAT",
+    "MethodLocalizer",
+    "open_method",
+    "save_method",
+]
 
 BATCH = 16  # views per embed() call
 METHOD_FILE = "method.json"  # name, epsilon and its source, dataset identity, trained
-STATE_FILE = "method.pt"  # a fitted method, pickled by torch.save
+STATE_FILE = "method.pt"  # a fitted method's state: {"format": STATE_FORMAT, "state": ...}
+# 2: the method's state_dict(), tensors and plain data; 1 (no "format" key, read until the
+# next release): the whole method object pickled by torch.save
+STATE_FORMAT = 2
+_PLAIN = (str, int, float, bool, type(None))  # what a state holds besides tensors
 
 
 class MethodLocalizer:
@@ -100,7 +117,7 @@ class MethodLocalizer:
         vectors = torch.cat(parts)
         if self._similarity is None:
             vectors = F.normalize(vectors.float(), dim=1)  # cosine: unit rows, dot products
-        return vectors.numpy().astype(np.float32)
+        return vectors.float().numpy()  # float32 (bfloat16 has no numpy type)
 
     def score(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """(P,) similarity of the row pairs (a[k], b[k]) of :meth:`embed`'s vectors."""
@@ -138,13 +155,17 @@ def save_method(
     epsilon_source: str,
     data: Path,
 ) -> Path:
-    """Write ``method.json`` (and, for a method with ``fit``, ``method.pt``: the fitted object)
-    into ``directory``, so that :func:`open_method` gives the same localizer back."""
+    """Write ``method.json`` (and, for a method with ``fit``, ``method.pt``: its
+    ``state_dict()``) into ``directory``, so that :func:`open_method` gives the same localizer
+    back, in this interpreter or a fresh one.
+
+    Raises:
+        MethodError: a trained method without ``state_dict`` / ``load_state_dict``, or whose
+            state holds something other than tensors and plain data (nothing is written).
+    """
     trained = callable(getattr(method, "fit", None))
     if trained:
-        buffer = io.BytesIO()
-        torch.save(method, buffer)
-        atomic_write_bytes(directory / STATE_FILE, buffer.getvalue())
+        atomic_write_bytes(directory / STATE_FILE, _state_bytes(name, method))
     record = {
         "method": 1,
         "name": name,
@@ -155,6 +176,57 @@ def save_method(
     }
     atomic_write_text(directory / METHOD_FILE, json.dumps(record, indent=1))
     return directory / METHOD_FILE
+
+
+def _state_bytes(name: str, method: Any) -> bytes:
+    """``method.pt``'s bytes: the format and the method's ``state_dict()``, checked plain."""
+    missing = [
+        m for m in ("state_dict", "load_state_dict") if not callable(getattr(method, m, None))
+    ]
+    if missing:
+        raise MethodError(
+            f"method {name!r} is trained (it has fit) but has no {' / '.join(missing)}: add "
+            "state_dict() -> a dict of tensors and plain data, and load_state_dict(state) that "
+            "puts it back into the method its factory builds (docs/benchmark.md) (check: state)"
+        )
+    state = guarded(name, "state_dict", method.state_dict)
+    if not isinstance(state, dict):
+        raise MethodError(
+            f"method {name!r}: state_dict returned {type(state).__name__}; expected a dict "
+            "(check: state)"
+        )
+    bad = _not_plain(state, "state")
+    if bad is not None:
+        where, value = bad
+        raise MethodError(
+            f"method {name!r}: {where} is a {type(value).__name__}; a state holds tensors, "
+            "str, int, float, bool, None, and lists, tuples and dicts (str or int keys) of them "
+            "(check: state)"
+        )
+    buffer = io.BytesIO()
+    torch.save({"format": STATE_FORMAT, "state": state}, buffer)
+    return buffer.getvalue()
+
+
+def _not_plain(value: Any, where: str) -> tuple[str, Any] | None:
+    """The first place in ``value`` that is not a tensor or plain data, and what is there."""
+    if isinstance(value, (torch.Tensor, *_PLAIN)):
+        return None
+    if isinstance(value, dict):
+        for key, item in value.items():
+            if not isinstance(key, str | int):
+                return f"{where} key {key!r}", key
+            found = _not_plain(item, f"{where}[{key!r}]")
+            if found is not None:
+                return found
+        return None
+    if isinstance(value, list | tuple):
+        for k, item in enumerate(value):
+            found = _not_plain(item, f"{where}[{k}]")
+            if found is not None:
+                return found
+        return None
+    return where, value
 
 
 def _read_record(path: Path) -> dict[str, Any]:
@@ -192,7 +264,7 @@ def open_method(
     if (directory / METHOD_FILE).is_file():
         record = _read_record(directory / METHOD_FILE)
         name = record["name"]
-        factory, _ = load_method(name)  # imports the method's module (for the pickle too)
+        factory, _ = load_method(name)  # the method's module; its factory rebuilds it
         state = directory / STATE_FILE
         if record.get("trained"):
             if not state.is_file():
@@ -204,7 +276,7 @@ def open_method(
                     f"than {data}'s"
                 )
             blob = state.read_bytes()
-            method = guarded(name, "loading its state", _load_state, blob)
+            method = _restore(name, factory, blob, state)
             digest = hashlib.sha256(blob).hexdigest()
         else:
             method, digest = guarded(name, "its factory", factory), _name_digest(name)
@@ -237,5 +309,50 @@ def open_method(
     )  # fmt: skip
 
 
-def _load_state(blob: bytes) -> Any:
+def _restore(name: str, factory: Any, blob: bytes, path: Path) -> Any:
+    """The fitted method ``method.pt``'s bytes hold: the factory's method, its state loaded.
+
+    Raises:
+        MethodError: not a method state; the method has no ``load_state_dict``, or it raised.
+    """
+    try:
+        saved = torch.load(io.BytesIO(blob), map_location="cpu", weights_only=True)
+    except pickle.UnpicklingError:  # no plain-data file: format 1, the pickled method itself
+        return _legacy(name, blob, path)
+    except Exception as exc:  # noqa: BLE001 - torch raises many types for a damaged file
+        raise MethodError(
+            f"{path}: unreadable method state ({type(exc).__name__}); benchmark it again"
+        ) from None
+    if not isinstance(saved, dict) or saved.get("format") != STATE_FORMAT or "state" not in saved:
+        raise MethodError(
+            f"{path}: not a method state of format {STATE_FORMAT}; benchmark it again"
+        )
+    method = guarded(name, "its factory", factory)
+    load = getattr(method, "load_state_dict", None)
+    if not callable(load):
+        raise MethodError(
+            f"method {name!r} has no load_state_dict(state) to take {path} back; add it "
+            "(docs/benchmark.md) (check: state)"
+        )
+    guarded(name, "load_state_dict", load, saved["state"])
+    return method
+
+
+def _legacy(name: str, blob: bytes, path: Path) -> Any:
+    """A ``method.pt`` of format 1 (the whole method, pickled), read until the next release."""
+    method = guarded(name, "loading its state", _unpickle, blob)
+    if isinstance(method, dict) and "format" in method:  # format 2 that weights_only refused
+        raise MethodError(
+            f"{path}: a state of method {name!r} holding more than plain data; benchmark it again"
+        )
+    warnings.warn(
+        f"{path}: a pickled method (format 1), read until the next release; run seannet "
+        f"benchmark again to write its state_dict (format {STATE_FORMAT})",
+        DeprecationWarning,
+        stacklevel=4,
+    )
+    return method
+
+
+def _unpickle(blob: bytes) -> Any:
     return torch.load(io.BytesIO(blob), map_location="cpu", weights_only=False)

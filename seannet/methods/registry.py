@@ -44,7 +44,11 @@ class Method(Protocol):
             ``train``, make every choice on ``val``; called once per seed;
         ``uses_boxes`` (bool): the box-noise sweep applies;
         ``image_size`` (int, default 224) and ``network`` (a registry network whose input
-            normalisation ``views.normalised`` uses; default ImageNet statistics).
+            normalisation ``views.normalised`` uses; default ImageNet statistics);
+        ``state_dict() -> dict`` and ``load_state_dict(state)`` (needed with ``fit``): the
+            fitted state as tensors and plain data, and putting it back into a fresh object
+            of the factory; a benchmark card directory keeps it (``method.pt``) and
+            :func:`~seannet.methods.localizer.open_method` rebuilds the method from it.
     """
 
     def embed(self, views: Any) -> Tensor: ...
