@@ -1,8 +1,10 @@
 """Benchmark cards (one per method: ``card.json``, ``card.md``, ``sweep.png``) and the
 leaderboard that merges them (``seannet leaderboard DIR...``).
 
-A card is stamped with the commit, the data fingerprint (manifest sha256) and the command
-(:mod:`seannet.provenance`); the leaderboard never mixes cards of different data in one table.
+A card is stamped with the commit, the data fingerprint (manifest sha256), the command
+(:mod:`seannet.provenance`) and the date it was written; the leaderboard never mixes cards of
+different data in one table, and its stamp names each distinct (commit, data, command) once,
+with the cards it made (:func:`cards_stamp`).
 """
 
 from __future__ import annotations
@@ -18,10 +20,18 @@ from PIL import Image, ImageDraw, ImageFont
 
 from seannet.errors import MethodError
 from seannet.markdown import pct, table
-from seannet.provenance import provenance_record, stamp
+from seannet.provenance import provenance_record
 from sgdata.fileio import atomic_write_text, save_png
 
-__all__ = ["CARD", "card_dir", "leaderboard", "method_label", "read_cards", "write_card"]
+__all__ = [
+    "CARD",
+    "card_dir",
+    "cards_stamp",
+    "leaderboard",
+    "method_label",
+    "read_cards",
+    "write_card",
+]
 
 CARD = "card.json"  # with card.md and sweep.png beside it
 _SAFE = re.compile(r"[^A-Za-z0-9_.+@-]+")
@@ -41,6 +51,38 @@ def card_dir(out: Path, name: str) -> Path:
     return out / method_label(name)
 
 
+def cards_stamp(cards: list[dict[str, Any]]) -> str:
+    """A markdown line naming what made ``cards``: each distinct (commit, data, command) once,
+    with the cards it made and the date they were written. Empty for no card."""
+    made: dict[tuple[Any, ...], list[dict[str, Any]]] = {}
+    for card in cards:
+        p = card["provenance"]
+        key = (p.get("commit"), bool(p.get("dirty")), p.get("manifest_sha256"), p.get("command"))
+        made.setdefault(key, []).append(card)
+    parts = []
+    for (commit, dirty, digest, command), group in made.items():
+        first = group[0]["provenance"]
+        data = ""
+        if digest:
+            seed = first.get("dataset_seed")
+            seed = f"dataset seed {seed}, " if seed is not None else ""
+            data = (
+                f" on `{first.get('data')}` ({seed}format {first.get('format_version')}, "
+                f"manifest sha256 `{digest[:16]}…`)"
+            )
+        # a card's provenance is recorded as it is written (write_card): its "started"
+        days = sorted({str(c["provenance"].get("started", "?"))[:10] for c in group})
+        when = days[0] if len(days) == 1 else f"{days[0]} to {days[-1]}"
+        names = ", ".join(f"`{c['method']}`" for c in group)
+        what = "card" if len(group) == 1 else f"{len(group)} cards"
+        changes = " with uncommitted changes" if dirty else ""
+        parts.append(
+            f"{what} {names} written {when} by commit `{str(commit)[:10]}`{changes}{data}: "
+            f"`{command}`"
+        )
+    return f"*Made by {'; '.join(parts)}.*" if parts else ""
+
+
 def _interval(entry: dict[str, float]) -> str:
     if "low" in entry:
         return f"{pct(entry['mean'])} [{pct(entry['low'])}, {pct(entry['high'])}]"
@@ -54,7 +96,7 @@ def _markdown(card: dict[str, Any]) -> str:
     lines = [
         f"# Benchmark card: {card['method']}",
         "",
-        stamp([card["provenance"]]),
+        cards_stamp([card]),
         "",
         f"- {kind}; test read once; every choice on val (epsilon {s['epsilon']:.3f})",
         f"- triplet accuracy: **{_interval(s['accuracy_rooms_seeds'])} %** (rooms x seeds, "
@@ -226,5 +268,5 @@ def leaderboard(cards: list[dict[str, Any]]) -> str:
             for c in group
         ]
         lines += [f"Data: manifest sha256 `{fingerprint[:16]}…`", "", *table(header, rows), ""]
-        lines += [stamp([c["provenance"] for c in group]), ""]
+        lines += [cards_stamp(group), ""]
     return "\n".join(lines)
