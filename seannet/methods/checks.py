@@ -16,25 +16,52 @@ _TOLERANCE = 1e-4  # how far past [-1, 1] a similarity may round
 
 
 def guarded(name: str, what: str, call: Callable[..., Any], *args: Any) -> Any:
-    """``call(*args)``, an exception inside the method becoming one line naming it."""
+    """``call(*args)``, an exception inside the method becoming one line naming it (a
+    :class:`MethodError` of the checks, e.g. a read of the pose, passes as it is)."""
     try:
         return call(*args)
-    except MethodError:
-        raise
     except Exception as exc:  # noqa: BLE001 - whatever a user's method raises
-        text = " ".join(str(exc).split())[:200]
+        if isinstance(exc, MethodError) and _names(exc, name):
+            raise
+        text = " ".join(_text(exc).split())[:200]
         raise MethodError(
             f"method {name!r}: {what} raised {type(exc).__name__}: {text} (check: no exception)"
         ) from None
 
 
+def _names(exc: MethodError, name: str) -> bool:
+    """Whether ``exc`` is one line of the checks about method ``name``."""
+    text = _text(exc)
+    return f"method {name!r}" in text and "(check: " in text and "\n" not in text
+
+
+def _text(exc: BaseException) -> str:
+    """``str(exc)``, or a note when the exception cannot say what it is."""
+    try:
+        return str(exc)
+    except Exception:  # noqa: BLE001 - a user's exception whose __str__ fails
+        return "(its message cannot be read)"
+
+
+def _plain(out: Tensor) -> bool:
+    """A dense tensor of real numbers (not sparse, not complex): what the checks can read."""
+    return out.layout == torch.strided and not out.is_complex()
+
+
 def checked_vectors(name: str, out: Any, n: int, width: int | None) -> Tensor:
-    if not isinstance(out, Tensor):
+    """``embed``'s output for ``n`` views, checked: a dense float tensor [n, D], D >= 1 (the
+    ``width`` of the batches before when given), finite; detached, on the CPU."""
+    if not isinstance(out, Tensor) or out.layout != torch.strided:
+        kind = type(out).__name__ if not isinstance(out, Tensor) else f"a {out.layout} tensor"
         raise MethodError(
-            f"method {name!r}: embed returned {type(out).__name__}; expected a Tensor [N, D] "
-            "(check: type)"
+            f"method {name!r}: embed returned {kind}; expected a dense Tensor [N, D] (check: type)"
         )
-    if out.dim() != 2 or out.shape[0] != n or (width is not None and out.shape[1] != width):
+    if (
+        out.dim() != 2
+        or out.shape[0] != n
+        or out.shape[1] < 1
+        or (width is not None and out.shape[1] != width)
+    ):
         want = f"[{n}, {width if width is not None else 'D'}]"
         raise MethodError(
             f"method {name!r}: embed returned shape {list(out.shape)} for {n} views; expected "
@@ -53,11 +80,12 @@ def checked_vectors(name: str, out: Any, n: int, width: int | None) -> Tensor:
 def checked_similarity(name: str, similarity: Callable[..., Any], a: Tensor, b: Tensor) -> Tensor:
     """``similarity(a, b)`` of row pairs, checked: a float tensor [P], finite, in [-1, 1]."""
     s = guarded(name, "similarity", similarity, a, b)
-    if not isinstance(s, Tensor) or tuple(s.shape) != (len(a),):
+    if not isinstance(s, Tensor) or not _plain(s) or tuple(s.shape) != (len(a),):
         shape = list(s.shape) if isinstance(s, Tensor) else type(s).__name__
+        kind = f" {s.layout} {s.dtype}" if isinstance(s, Tensor) and not _plain(s) else ""
         raise MethodError(
-            f"method {name!r}: similarity returned {shape} for {len(a)} pairs; "
-            f"expected a Tensor [{len(a)}] (check: similarity shape)"
+            f"method {name!r}: similarity returned{kind} {shape} for {len(a)} pairs; "
+            f"expected a dense real Tensor [{len(a)}] (check: similarity shape)"
         )
     s = s.detach().double().cpu()
     if not bool(torch.isfinite(s).all()):

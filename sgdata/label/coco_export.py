@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from sgdata.errors import ConfigError
+from sgdata.errors import ConfigError, DatasetError
 from sgdata.label.detector_files import is_real
 
 __all__ = ["CocoSummary", "export_coco"]
@@ -59,7 +59,9 @@ def export_coco(
     Raises:
         ConfigError: ``masks`` on a dataset without instance masks, or without pycocotools;
             ``out`` not empty; an unknown split. Nothing is written then.
-        DatasetError: ``dataset_dir`` is not a readable dataset.
+        DatasetError: ``dataset_dir`` is not a readable dataset, or a view cannot be written
+            (a box off its image, an unknown class, a mask of another size). Nothing is
+            written then.
     """
     from sgdata.dataset import Dataset
     from sgdata.dataset.channels import decode_channel
@@ -106,6 +108,7 @@ def export_coco(
                             "export without --masks"
                         )
                     mask = decode_channel(row["instances"], where=f"{row['obs_id']}: instances")
+                    _check_mask(mask, row)
                 for k, obj in enumerate(row["objects"]):
                     u1, v1, u2, v2 = obj["box2d"]
                     ann: dict[str, Any] = {
@@ -135,6 +138,21 @@ def export_coco(
             summary.images += len(images)
             summary.annotations += len(annotations)
     return summary
+
+
+def _check_mask(mask: np.ndarray, row: dict[str, Any]) -> None:
+    """Refuse an instance mask of another size than its view, or naming an unlisted object."""
+    size, count = (row["camera"]["height"], row["camera"]["width"]), len(row["objects"])
+    if mask.shape != size:
+        raise DatasetError(
+            f"view {row['obs_id']}: instance mask of {mask.shape[1]} x {mask.shape[0]} pixels; "
+            f"expected the camera's {size[1]} x {size[0]}"
+        )
+    if int(mask.max(initial=0)) > count:
+        raise DatasetError(
+            f"view {row['obs_id']}: instance mask holds {int(mask.max())} but the view lists "
+            f"{count} objects"
+        )
 
 
 def _require_masks(ds: Any, dataset_dir: Path) -> None:

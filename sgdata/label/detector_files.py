@@ -15,12 +15,13 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
-from sgdata.errors import ConfigError
+from sgdata.errors import ConfigError, DatasetError
 
 __all__ = [
     "DETECTOR_FORMATS",
     "EXPORT_FORMATS",
     "check_format",
+    "check_view_row",
     "export_splits",
     "image_file_name",
     "is_real",
@@ -84,13 +85,52 @@ def view_rows(
     dataset: Any, splits: Sequence[str], extra: Sequence[str] = ()
 ) -> Iterator[dict[str, Any]]:
     """The rows of ``splits`` of an opened :class:`~sgdata.dataset.Dataset`, shard by shard,
-    with the columns the exports need (images as encoded bytes) and ``extra``."""
+    with the columns the exports need (images as encoded bytes) and ``extra``.
+
+    Raises:
+        DatasetError: a row the exports cannot write (:func:`check_view_row`).
+    """
     from sgdata.dataset import observations_schema, read_table
 
     columns = [*ROW_COLUMNS, *extra]
+    classes = len(dataset.manifest.classes)
     for split in splits:
         for shard in dataset.observation_files(split):
-            yield from read_table(shard, observations_schema(), columns=columns).to_pylist()
+            for row in read_table(shard, observations_schema(), columns=columns).to_pylist():
+                yield check_view_row(row, classes)
+
+
+def check_view_row(row: dict[str, Any], classes: int) -> dict[str, Any]:
+    """``row`` if the detector files can hold it: a camera of positive size, every object's
+    class one of the ``classes`` of the vocabulary, its box ``[u1, v1, u2, v2]`` inside the
+    image with ``u1 <= u2`` and ``v1 <= v2``, its visible pixels not negative.
+
+    Raises:
+        DatasetError: naming the view, the value and what was expected (``sgdata validate``
+            reports the dataset's other problems).
+    """
+    width, height = row["camera"]["width"], row["camera"]["height"]
+    where = f"view {row['obs_id']}"
+    if width < 1 or height < 1:
+        raise DatasetError(f"{where}: camera {width} x {height}; expected a positive size")
+    for obj in row["objects"]:
+        u1, v1, u2, v2 = obj["box2d"]
+        if not 0 <= obj["class_id"] < classes:
+            raise DatasetError(
+                f"{where}: object {obj['instance']} of class id {obj['class_id']}; expected "
+                f"0 to {classes - 1} (the manifest's classes)"
+            )
+        if not (0 <= u1 <= u2 <= width and 0 <= v1 <= v2 <= height):
+            raise DatasetError(
+                f"{where}: object {obj['instance']} box {[u1, v1, u2, v2]}; expected "
+                f"[u1, v1, u2, v2] with 0 <= u1 <= u2 <= {width} and 0 <= v1 <= v2 <= {height}"
+            )
+        if obj["visible_pixels"] < 0:
+            raise DatasetError(
+                f"{where}: object {obj['instance']} has {obj['visible_pixels']} visible pixels; "
+                "expected 0 or more"
+            )
+    return row
 
 
 def export_splits(dataset: Any, split: str | None) -> list[str]:

@@ -45,7 +45,8 @@ def export_yolo(
     Raises:
         ConfigError: ``out`` not empty (without ``force``), an unknown split; nothing is
             written then.
-        DatasetError: ``dataset_dir`` is not a readable dataset.
+        DatasetError: ``dataset_dir`` is not a readable dataset, or a view cannot be written
+            (a box off its image, an unknown class). Nothing is written then.
     """
     from sgdata.dataset import Dataset
     from sgdata.fileio import atomic_write_bytes, atomic_write_text

@@ -48,6 +48,8 @@ class Surface:
     )
     # failure substring -> where that defect is reported (found here, fixed by its owner)
     known: dict[str, str] = field(default_factory=dict)
+    # the one-line errors that refuse an input (seannet's surfaces: its own hierarchy)
+    refusals: tuple[type[Exception], ...] = (SgdataError,)
 
 
 @dataclass
@@ -90,7 +92,7 @@ def check_contract(surface: Surface, example: Any, work: Path, session: Any) -> 
     refused = False
     try:
         surface.feed(example, work, session)
-    except SgdataError as exc:
+    except surface.refusals as exc:
         refused = True
         text = str(exc)
         if not text.strip() or "\n" in text.strip():
@@ -102,8 +104,9 @@ def check_contract(surface: Surface, example: Any, work: Path, session: Any) -> 
         return Failure(f"wrong result: {str(exc).split(':')[0][:80]}", str(exc), example)
     except Exception as exc:  # noqa: BLE001 - any other exception is the traceback we hunt
         frames = traceback.extract_tb(exc.__traceback__)
-        ours = [f for f in frames if "/sgdata/" in f.filename] or frames
-        where = f"{Path(ours[-1].filename).name}:{ours[-1].lineno}"  # the last line of sgdata's
+        ours = [f for f in frames if "/sgdata/" in f.filename or "/seannet/" in f.filename]
+        ours = ours or frames
+        where = f"{Path(ours[-1].filename).name}:{ours[-1].lineno}"  # the last line of ours
         return Failure(f"traceback: {type(exc).__name__} at {where}", str(exc)[:300], example)
     temps = sorted(str(p.relative_to(work)) for p in work.rglob(TEMP_GLOB))
     if temps:

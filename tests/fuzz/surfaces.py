@@ -6,8 +6,10 @@ from . import (
     surface_assets,
     surface_configs,
     surface_datasets,
+    surface_exports,
     surface_label_files,
     surface_label_server,
+    surface_methods,
     surface_usd_rooms,
 )
 from .harness import Surface
@@ -23,5 +25,7 @@ SURFACES: dict[str, Surface] = {
         surface_label_server,
         surface_datasets,
         surface_assets,
+        surface_methods,
+        surface_exports,
     )
 }

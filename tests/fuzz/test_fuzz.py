@@ -23,6 +23,13 @@ EXAMPLES = {
     "label server request bodies": 30,
     "datasets (Dataset.open, validate)": 12,
     "mesh assets": 40,
+    "localization methods (checks)": 100,
+    "detector exports (COCO, YOLO)": 16,
+}
+# the surfaces whose examples edit copies of a dataset of the suite's (a session fixture)
+DATASETS = {
+    "datasets (Dataset.open, validate)": "mini_dataset",
+    "detector exports (COCO, YOLO)": "channels_dataset",
 }
 # A campaign (bench/fuzz.py) sets these: examples per surface, the hypothesis seed, the
 # surfaces to run (a JSON list; default all) and a JSON-lines file each surface's report goes to.
@@ -43,8 +50,8 @@ def test_every_surface_keeps_the_contract(
         pytest.skip("not in this campaign")
     examples = int(examples_env) if examples_env else EXAMPLES[name]
     surface = SURFACES[name]
-    # the datasets surface corrupts copies of the suite's shared mini dataset
-    session = request.getfixturevalue("mini_dataset") if name.startswith("datasets") else None
+    # the datasets surfaces edit copies of the suite's shared datasets
+    session = request.getfixturevalue(DATASETS[name]) if name in DATASETS else None
     start = time.perf_counter()
     report = campaign(
         surface, examples, seed=int(seed_env or 0), session=session, work_root=tmp_path
