@@ -48,9 +48,15 @@ from seannet.errors import MethodError
 from seannet.evaluation.intervals import per_room_matrix, t_interval, two_level_interval
 from seannet.evaluation.retrieval import map_queries
 from seannet.methods.change import change_of_pairs, sweep
-from seannet.methods.checks import checked_similarity, checked_vectors, guarded
+from seannet.methods.checks import (
+    checked_image_input,
+    checked_similarity,
+    checked_vectors,
+    embed_views,
+    guarded,
+)
 from seannet.methods.registry import load_method
-from seannet.methods.views import Budget, SplitData, Views
+from seannet.methods.views import Budget, SplitData
 
 __all__ = ["BenchmarkConfig", "NOISE_LEVELS", "benchmark_method", "breaking_point", "summarize"]
 
@@ -111,8 +117,7 @@ class _Harness:
         self.similarity = getattr(method, "similarity", None)
 
     def transform(self) -> ImageTransform:
-        size = int(getattr(self.method, "image_size", 224))
-        return ImageTransform.for_model(size, str(getattr(self.method, "network", "resnet")))
+        return ImageTransform.for_model(*checked_image_input(self.name, self.method))
 
     def loader(self, split: str, noise: BoxNoise | None = None) -> DataLoader:
         views = ObservationDataset(self.dataset, split, transform=self.transform(), noise=noise)
@@ -123,7 +128,7 @@ class _Harness:
         seconds = 0.0
         for batch, info in self.loader(split, noise):
             start = time.perf_counter()
-            out = guarded(self.name, "embed", self.method.embed, Views(batch, method=self.name))
+            out = embed_views(self.name, self.method, batch)
             seconds += time.perf_counter() - start
             out = checked_vectors(self.name, out, batch.num_views, self.width)
             self.width = out.shape[1]

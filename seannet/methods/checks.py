@@ -8,11 +8,14 @@ from typing import Any
 import torch
 from torch import Tensor
 
+from seannet.data.batch import SceneBatch
 from seannet.errors import MethodError
+from seannet.methods.views import Views
 
-__all__ = ["checked_similarity", "checked_vectors", "guarded"]
+__all__ = ["checked_image_input", "checked_similarity", "checked_vectors", "embed_views", "guarded"]
 
 _TOLERANCE = 1e-4  # how far past [-1, 1] a similarity may round
+MAX_IMAGE_SIZE = 1024  # pixels a side: past this a CPU benchmark would not end
 
 
 def guarded(name: str, what: str, call: Callable[..., Any], *args: Any) -> Any:
@@ -27,6 +30,36 @@ def guarded(name: str, what: str, call: Callable[..., Any], *args: Any) -> Any:
         raise MethodError(
             f"method {name!r}: {what} raised {type(exc).__name__}: {text} (check: no exception)"
         ) from None
+
+
+def embed_views(name: str, method: Any, batch: SceneBatch) -> Any:
+    """``method.embed`` of one batch as :class:`Views`, guarded; a method that read a hidden
+    field (the pose) is refused even when it caught the error and carried on."""
+    views = Views(batch, method=name)
+    out = guarded(name, "embed", method.embed, views)
+    if views.hidden_reads:
+        raise MethodError(
+            f"method {name!r} read views.{views.hidden_reads[0]} and carried on: a method "
+            "never sees the pose (check: no pose)"
+        )
+    return out
+
+
+def checked_image_input(name: str, method: Any) -> tuple[int, str]:
+    """The method's ``image_size`` (default 224) and ``network`` (default ``"resnet"``, the
+    normalisation family), checked: an integer side in [8, MAX_IMAGE_SIZE] and a string."""
+    size, network = getattr(method, "image_size", 224), getattr(method, "network", "resnet")
+    if isinstance(size, bool) or not isinstance(size, int) or not 8 <= size <= MAX_IMAGE_SIZE:
+        raise MethodError(
+            f"method {name!r}: image_size {size!r}; expected an integer side in pixels in "
+            f"[8, {MAX_IMAGE_SIZE}] (check: image input)"
+        )
+    if not isinstance(network, str):
+        raise MethodError(
+            f"method {name!r}: network {network!r}; expected a name such as 'resnet' "
+            "(check: image input)"
+        )
+    return size, network
 
 
 def _names(exc: MethodError, name: str) -> bool:

@@ -40,9 +40,14 @@ from seannet.data.collate import ViewTensors, collate_views
 from seannet.data.opening import dataset_identity
 from seannet.data.view_inputs import ImageTransform
 from seannet.errors import MethodError
-from seannet.methods.checks import checked_similarity, checked_vectors, guarded
+from seannet.methods.checks import (
+    checked_image_input,
+    checked_similarity,
+    checked_vectors,
+    embed_views,
+    guarded,
+)
 from seannet.methods.registry import load_method
-from seannet.methods.views import Views
 from seannet.training.runs import MODEL_KEYS
 from sgdata.fileio import atomic_write_bytes, atomic_write_text
 
@@ -100,8 +105,7 @@ class MethodLocalizer:
     @property
     def transform(self) -> ImageTransform:
         """The image transform the method reads views with (its size and normalisation)."""
-        size = int(getattr(self.method, "image_size", 224))
-        return ImageTransform.for_model(size, str(getattr(self.method, "network", "resnet")))
+        return ImageTransform.for_model(*checked_image_input(self.name, self.method))
 
     def embed(self, views: Sequence[ViewTensors]) -> np.ndarray:
         """(N, D) float32 vectors of views (made with :attr:`transform`), checked."""
@@ -109,7 +113,7 @@ class MethodLocalizer:
         for start in range(0, len(views), BATCH):
             batch, _ = collate_views(list(views[start : start + BATCH]))
             with torch.no_grad():
-                out = guarded(self.name, "embed", self.method.embed, Views(batch, method=self.name))
+                out = embed_views(self.name, self.method, batch)
             width = parts[0].shape[1] if parts else None
             parts.append(checked_vectors(self.name, out, batch.num_views, width))
         if not parts:

@@ -37,20 +37,23 @@ class Views:
 
     Reading ``pose``, ``grid_i``, ``obs_id`` or any other field of :data:`HIDDEN_FIELDS` raises
     a :class:`~seannet.errors.MethodError` naming the method: a localizer that saw where the
-    camera stood would grade its own answer.
+    camera stood would grade its own answer. The read is remembered (:attr:`hidden_reads`),
+    so a method that catches the error is refused all the same.
     """
 
-    __slots__ = ("_batch", "_method")
+    __slots__ = ("_batch", "_method", "_hidden_reads")
 
     def __init__(self, batch: SceneBatch, *, method: str = "?") -> None:
         object.__setattr__(self, "_batch", batch)
         object.__setattr__(self, "_method", method)
+        object.__setattr__(self, "_hidden_reads", [])
 
     def __len__(self) -> int:
         return self._batch.num_views
 
     def __getattr__(self, name: str) -> object:
         if name in HIDDEN_FIELDS:
+            self._hidden_reads.append(name)
             raise MethodError(
                 f"method {self._method!r} read views.{name}: a method never sees the pose "
                 "(check: no pose)"
@@ -59,6 +62,11 @@ class Views:
 
     def __setattr__(self, name: str, value: object) -> None:
         raise AttributeError("Views are read-only")
+
+    @property
+    def hidden_reads(self) -> tuple[str, ...]:
+        """The hidden fields a method tried to read from these views, in order."""
+        return tuple(self._hidden_reads)
 
     @property
     def batch(self) -> SceneBatch:

@@ -114,9 +114,29 @@ class _Peeks(_Constant):
         return torch.ones(len(views), 3) * views.heading  # type: ignore[attr-defined]
 
 
+class _PeeksQuietly(_Constant):
+    def embed(self, views: Views) -> torch.Tensor:
+        try:
+            views.pose  # type: ignore[attr-defined]  # noqa: B018
+        except MethodError:
+            pass  # caught, and carries on as if it had not looked
+        return torch.ones(len(views), 3)
+
+
+class _HugeImages(_Constant):
+    image_size = 100_000
+
+
+class _FloatImages(_Constant):
+    image_size = 64.5
+
+
 @pytest.mark.parametrize(
     ("method", "check"),
     [
+        (_PeeksQuietly, "check: no pose"),
+        (_HugeImages, "check: image input"),
+        (_FloatImages, "check: image input"),
         (_NaN, "check: finite"),
         (_WrongN, "check: shape"),
         (_Ints, "check: dtype"),
