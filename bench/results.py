@@ -704,9 +704,11 @@ def tables(runs: Path) -> str:
         "fc",
         "A narrower GCN fc",
         "`seannet-fc512`: the GCN's fc 6,144 -> 512 -> 2,048 instead of the paper's "
-        "6,144 -> 4,096 -> 2,048; its CPU step is near ResNet-18's (docs/benchmarks.md). "
+        "6,144 -> 4,096 -> 2,048; its CPU step is near ResNet-18's "
+        '(docs/benchmarks-2026-12-02.md, "A training step"). '
         "The batch counts below say how far the budget's calibrations put the two apart.",
     )
+    out += CURVE_SECTION
     ablations = runs / "comparison-ablations.json"
     missing = (
         []
@@ -731,6 +733,19 @@ def tables(runs: Path) -> str:
     ]
     return "\n".join(out) + "\n"
 
+
+# The learning curve has its own runs and page (bench/learning_curve.py); shown here as its plot
+CURVE_SECTION = [
+    "",
+    "## Accuracy against the training budget",
+    "",
+    "Whether the aims above are a matter of compute: SeanNet, resnet18+boxes and "
+    "seannet+box-kernel trained at growing budgets, lr chosen on val at the first, "
+    "val and test read per run. Runs, tables and stamp: "
+    "[learning-curve.md](learning-curve.md) (`bench/learning_curve.py`).",
+    "",
+    "![accuracy against budget](learning-curve.png)",
+]
 
 # What the runs above do not cover, and why; printed under the tables.
 NOT_MEASURED = [

@@ -37,7 +37,8 @@ class ModelConfig:
     visual_features: str = "c4_head"
     embed_dim: int = 2048
     # hidden width of the GCN's fc (M x 24 -> graph_hidden -> embed_dim); 4096 is the paper's,
-    # and its 25 M weights are a fifth of a CPU training step (docs/benchmarks.md)
+    # and its 25 M weights are a fifth of a CPU training step (docs/benchmarks-2026-12-02.md,
+    # "A training step")
     graph_hidden: int = 4096
     # cells per side of SeanNet's layout pathway (the scene graph's boxes slot by slot,
     # seannet.model.layers.SlotLayout); 0 leaves the paper's graph branch (GCN pathways only)
