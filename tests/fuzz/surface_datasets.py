@@ -46,17 +46,22 @@ corruptions = st.lists(
 )
 
 
-@contextlib.contextmanager
-def mini_dataset(root: Path) -> Iterator[Path]:
-    """The tests' mini dataset (three bathrooms), generated once for a campaign by the CLI."""
-    config = root / "mini.toml"
+def generate_with_cli(root: Path, config_text: str) -> Path:
+    """``sgdata generate`` of a config given as text, into ``root/data``: its root."""
+    config = root / "config.toml"
     config.parent.mkdir(parents=True, exist_ok=True)
-    config.write_text(MINI_TOML)
+    config.write_text(config_text)
     sgdata = str(Path(sys.executable).parent / "sgdata")
     subprocess.run(
         [sgdata, "generate", str(config), str(root / "data")], check=True, capture_output=True
     )
-    yield root / "data"
+    return root / "data"
+
+
+@contextlib.contextmanager
+def mini_dataset(root: Path) -> Iterator[Path]:
+    """The tests' mini dataset (three bathrooms), generated once for a campaign by the CLI."""
+    yield generate_with_cli(root, MINI_TOML)
 
 
 def _digest(root: Path) -> dict[str, str]:

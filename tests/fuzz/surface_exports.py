@@ -17,8 +17,6 @@ from __future__ import annotations
 import contextlib
 import io
 import shutil
-import subprocess
-import sys
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -36,6 +34,7 @@ from sgdata.label.yolo_export import export_yolo
 
 from ..conftest import CHANNELS_TOML
 from .harness import Surface
+from .surface_datasets import generate_with_cli
 
 SPLIT = "val"
 ROWS = 3  # views of the split kept: the export's cost per example
@@ -82,14 +81,7 @@ examples = st.lists(views, min_size=1, max_size=3)
 @contextlib.contextmanager
 def channels_dataset(root: Path) -> Iterator[Path]:
     """The tests' dataset with depth and instance masks, generated once for a campaign."""
-    config = root / "channels.toml"
-    config.parent.mkdir(parents=True, exist_ok=True)
-    config.write_text(CHANNELS_TOML)
-    sgdata = str(Path(sys.executable).parent / "sgdata")
-    subprocess.run(
-        [sgdata, "generate", str(config), str(root / "data")], check=True, capture_output=True
-    )
-    yield root / "data"
+    yield generate_with_cli(root, CHANNELS_TOML)
 
 
 def _mask(spec: dict[str, Any], height: int, width: int, count: int) -> bytes | None:
