@@ -77,6 +77,7 @@ def run(
     models: tuple[str, ...] = MODELS,
     *,
     preset: str | TrainConfig = "cpu",
+    lrs: tuple[float, ...] = LRS,
 ) -> None:
     """Train and evaluate every budget of the curve into ``runs`` (resuming). Each model is
     its own comparison (``selection-curve-<model>.json``), so a later call may carry some
@@ -89,7 +90,7 @@ def run(
     chosen: dict[str, dict[str, Any]] = {}
     for name in models:
         got = compare_models(
-            ds, base, (name,), preset=preset, seeds=tuple(range(first_seeds)), lrs=LRS,
+            ds, base, (name,), preset=preset, seeds=tuple(range(first_seeds)), lrs=lrs,
             budget_s=first, announce=print, tag=_tag(name), batches=_calibrated(base),
         )  # fmt: skip
         chosen[name] = got["models"][0]
@@ -142,7 +143,8 @@ def _evaluate(ds: Any, directory: Path, entries: list[dict[str, Any]]) -> None:
             rows.append({
                 "model": entry["model"], "run": str(run_dir), "lr": entry["lr"],
                 "batches_per_epoch": entry["batches_per_epoch"], "epochs": entry["epochs"],
-                "examples": entry["examples"], "val": val["accuracy"],
+                "examples": entry["examples"], "lrs_tried": list(entry["val_accuracy_by_lr"]),
+                "val": val["accuracy"],
                 "test": got["accuracy"],  # the comparison's test evaluation of this run
             })  # fmt: skip
     atomic_write_text(path, json.dumps({"runs": rows}, indent=2))
@@ -161,6 +163,7 @@ def read_curve(runs: Path) -> dict[str, list[dict[str, Any]]]:
             mine = [r for r in rows if r["model"] == model]
             points.setdefault(model, []).append({
                 "budget_s": budget, "seeds": len(mine), "lr": mine[0]["lr"],
+                "lrs_tried": mine[0].get("lrs_tried", []),
                 "batches_per_epoch": mine[0]["batches_per_epoch"], "epochs": mine[0]["epochs"],
                 "examples": mine[0]["examples"],
                 "val": t_interval([r["val"] for r in mine]),
@@ -173,6 +176,16 @@ def _cell(interval: dict[str, float]) -> str:
     if interval["n"] < 2:
         return f"{100 * interval['mean']:.1f} (1 seed)"
     return f"{100 * interval['mean']:.1f} ± {100 * interval['ci95']:.1f}"
+
+
+def _lr(point: dict[str, Any], k: int) -> str:
+    """The lr, and at the first budget how it was set: chosen on val, or the only one tried."""
+    if k > 0:
+        return f"{point['lr']:g}"
+    tried = point["lrs_tried"]
+    if len(tried) > 1:
+        return f"{point['lr']:g} (val, of {' / '.join(tried)})"
+    return f"{point['lr']:g} (the only one tried)"
 
 
 def _flattens(points: list[dict[str, Any]]) -> str:
@@ -200,8 +213,9 @@ def tables(runs: Path, plot: Path) -> str:
         "Written by `python bench/learning_curve.py tables RUNS` from the run files; no figure "
         "is typed. Budgets are seconds of one thread's compute per run "
         "(`seannet/training/budget.py`); the first budget's calibration sets each network's "
-        "batches, larger budgets scale them, the lr is the one chosen on val at the first "
-        "budget. Intervals: 95 % t over seeds (a budget with one seed shows its single run).",
+        "batches, larger budgets scale them and keep the first budget's lr (chosen on val "
+        "when several were tried: the lr column says). Intervals: 95 % t over seeds (a "
+        "budget with one seed shows its single run).",
         "",
         *([stamp(records), ""] if records else []),
         f"![accuracy against budget]({plot.name})",
@@ -218,8 +232,8 @@ def tables(runs: Path, plot: Path) -> str:
         ]
         lines += [
             f"| {p['budget_s']:g} | {p['seeds']} | {p['batches_per_epoch']} x {p['epochs']} | "
-            f"{p['examples']:,} | {p['lr']:g} | {_cell(p['val'])} | {_cell(p['test'])} |"
-            for p in series
+            f"{p['examples']:,} | {_lr(p, k)} | {_cell(p['val'])} | {_cell(p['test'])} |"
+            for k, p in enumerate(series)
         ]
         lines.append("")
     save_png(draw_curve(points), plot)
@@ -288,13 +302,19 @@ def main() -> None:
     go.add_argument("runs", type=Path)
     go.add_argument("--budgets", default=",".join(f"{b:g}:{s}" for b, s in BUDGETS))
     go.add_argument("--models", default=",".join(MODELS))
+    go.add_argument(
+        "--lrs",
+        default=",".join(f"{lr:g}" for lr in LRS),
+        help="learning rates chosen from on val at the first budget (one: no choice)",
+    )
     write = sub.add_parser("tables", help="write the page and its plot from the runs")
     write.add_argument("runs", type=Path)
     write.add_argument("-o", "--output", type=Path, default=ROOT / "docs" / "learning-curve.md")
     args = parser.parse_args()
     if args.verb == "run":
         models = tuple(m.strip() for m in args.models.split(",") if m.strip())
-        run(args.data, args.runs, parse_budgets(args.budgets), models)
+        lrs = tuple(float(lr) for lr in args.lrs.split(","))
+        run(args.data, args.runs, parse_budgets(args.budgets), models, lrs=lrs)
     else:
         text = tables(args.runs, args.output.with_suffix(".png"))
         atomic_write_text(args.output, text)

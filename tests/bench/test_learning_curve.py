@@ -41,6 +41,7 @@ def test_curve_scales_the_first_budget_and_writes_the_runs(
     assert page.with_suffix(".png").stat().st_size > 1000
     assert "bench/learning_curve.py" in text and "commit" in text  # stamped
     assert f"{100 * last['test']['mean']:.1f} (1 seed)" in text
+    assert f"| {first['lr']:g} (val, of 0.003 / 0.01) |" in text
     assert f"{100 * first['val']['mean']:.1f} ± {100 * first['val']['ci95']:.1f}" in text
 
 
