@@ -5,8 +5,9 @@
 
 Whether the results' aims are a matter of compute: SeanNet (``seannet-fc512``, the ``cpu``
 preset's network), ``resnet18+boxes`` and ``seannet-fc512+box-kernel`` trained at growing
-budgets (seconds of one thread's compute per run, :mod:`seannet.training.budget`; 300 is about
-the 150 s of runs made before 2026-12-02). The protocol (DESIGN §12):
+budgets (seconds of one thread's compute per run, :mod:`seannet.training.budget`: 300 bought
+seannet-fc512 7 batches per epoch on the docs' machine, where the old ``--budget 150`` had bought
+35). The protocol (DESIGN §12):
 
 - the first budget is a ``seannet compare``: each network calibrated to it, the lr chosen on
   val among {0.003, 0.01} with the first seed, then its seeds;

@@ -17,8 +17,10 @@ a third to a quarter).
 On a GPU the steps are timed on the wall clock (after a synchronise): the GPU is the load.
 
 The seconds are one thread's, whatever threads the run itself will use: a run on two cores
-trains its budget in about half the wall time, and a budget now buys about half the batches
-the same number bought when the calibration divided process time by torch's threads.
+trains its budget in about half the wall time. A budget buys far fewer batches than the same
+number bought when the calibration divided process time by torch's threads: 300 s of one
+thread bought seannet-fc512 7 batches per epoch on the docs' machine (a step 7.5 s,
+2026-12-02), where the old 150 had recorded 35; 1,200 s (28) is the nearer match.
 
 The calibration is a measurement, so two on the same machine may differ by a few per cent:
 what a run got is recorded (:meth:`Calibration.to_dict`, in ``selection.json``) and reused,
