@@ -237,8 +237,31 @@ def tables(runs: Path, plot: Path) -> str:
             for k, p in enumerate(series)
         ]
         lines.append("")
+    missing = _missing(points)
+    if missing:
+        lines += [
+            "## Not run for this page",
+            "",
+            "The default design (`bench/learning_curve.py run DATA RUNS`) and what these runs "
+            "lack of it:",
+            "",
+            *[f"- {m}" for m in missing],
+            "",
+        ]
     save_png(draw_curve(points), plot)
     return "\n".join(lines)
+
+
+def _missing(points: dict[str, list[dict[str, Any]]]) -> list[str]:
+    """Each (model, budget) of the default design with fewer seeds here than it asks."""
+    out = []
+    for model in MODELS:
+        have = {p["budget_s"]: p["seeds"] for p in points.get(model, [])}
+        for budget, seeds in BUDGETS:
+            got = have.get(budget, 0)
+            if got < seeds:
+                out.append(f"{model} at {budget:g} s: {seeds} seed(s) asked, {got} run")
+    return out
 
 
 COLOURS = ((70, 110, 200), (200, 90, 60), (60, 160, 90), (140, 90, 170))

@@ -740,10 +740,10 @@ CURVE_SECTION = [
     "",
     "## Accuracy against the training budget",
     "",
-    "Whether the aims above are a matter of compute: SeanNet, resnet18+boxes and "
-    "seannet+box-kernel trained at growing budgets, lr chosen on val at the first, "
-    "val and test read per run. Runs, tables and stamp: "
-    "[learning-curve.md](learning-curve.md) (`bench/learning_curve.py`).",
+    "Whether the aims above are a matter of compute: accuracy on val and test against the "
+    "training budget. Its page, [learning-curve.md](learning-curve.md) "
+    "(`bench/learning_curve.py`), holds the runs' tables and stamp, and says which networks, "
+    "seeds and budgets of its design were run and which were not.",
     "",
     "![accuracy against budget](learning-curve.png)",
 ]
