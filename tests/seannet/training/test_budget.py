@@ -49,14 +49,14 @@ def _busy_machine(processes: int) -> Iterator[None]:
 
 
 def test_a_busy_machine_buys_the_same_batches(mini_dataset: Path) -> None:
-    # quiet and busy in turn, twice, each side's least disturbed calibration counting (as a
+    # quiet and busy in turn, three times, each side's least disturbed calibration counting (as a
     # calibration counts each batch's fastest round): the machine's other work varies too.
     # What still moves the figure: every switch to another process refills the caches, and
     # on a machine already running several jobs per core the busy loops multiply switches
     # (seen here at load 6 on 2 cores: 5 to 16 % fewer batches; at load 1.5: within 4 %)
     threads = torch.get_num_threads()
     quiet, busy = [], []
-    for _ in range(2):
+    for _ in range(3):  # twice failed once in a clean-clone run of the whole suite (2026-12-02)
         # a budget that buys some tens of batches, so that 10 % is a few of them
         quiet.append(calibrate(TINY, mini_dataset, 40.0, batches=3, rounds=3))
         if quiet[-1].busy > QUIET:
