@@ -55,8 +55,8 @@ def test_a_busy_machine_buys_the_same_batches(mini_dataset: Path) -> None:
     # on a machine already running several jobs per core the busy loops multiply switches
     # (seen here at load 6 on 2 cores: 5 to 16 % fewer batches; at load 1.5: within 4 %)
     threads = torch.get_num_threads()
-    # a budget that buys some sixty batches on this machine, whatever its speed, so that 10 %
-    # is a few of them (a fixed 40 s bought 40+ on one day's VM and 28 on a slower one)
+    # a budget that buys some sixty batches on this machine, whatever its speed, so that 20 %
+    # is several of them (a fixed 40 s bought 40+ on one day's VM and 28 on a slower one)
     budget = 60 * TINY.epochs * calibrate(TINY, mini_dataset, 1.0, batches=2, rounds=1).step_s
     quiet, busy = [], []
     for _ in range(3):  # twice failed once in a clean-clone run of the whole suite (2026-12-02)
@@ -71,9 +71,12 @@ def test_a_busy_machine_buys_the_same_batches(mini_dataset: Path) -> None:
     assert torch.get_num_threads() == threads  # the caller's threads are restored
     assert all(c.clock == CPU_CLOCK for c in quiet + busy)
     calm, loaded = max(c.batches for c in quiet), max(c.batches for c in busy)
-    assert calm >= 30  # tens of batches: a 10 % difference is a few of them
-    # the old clock (process CPU over torch's threads) gave a third to a quarter here
-    assert abs(loaded - calm) <= 0.1 * calm, (quiet, busy)
+    assert calm >= 30  # tens of batches: a 20 % difference is several of them
+    # the old clock (process CPU over torch's threads) gave a third to a quarter of the quiet
+    # batches here. The bound is wide on purpose: in CI's clean-clone run the *quiet* side
+    # was the slow one (54 quiet, 65 busy: the machine's own other work, not the busy loops),
+    # so a tight bound tests the host, not the clock
+    assert 0.8 * calm <= loaded <= 1.25 * calm, (quiet, busy)
 
 
 def test_the_calibration_records_what_the_budget_bought(mini_dataset: Path) -> None:
