@@ -41,11 +41,19 @@ fi
 [ -x .venv/bin/python ] || "$python" -m venv .venv
 
 stamp=.venv/.sgdata-installed
-want=$(cat pyproject.toml scripts/setup.sh | sha256sum | cut -d' ' -f1)
+pins=constraints/py$version.txt
+want=$(cat pyproject.toml scripts/setup.sh $([ -f "$pins" ] && echo "$pins") | sha256sum | cut -d' ' -f1)
 if [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
   echo "setup: installing Python dependencies into .venv on Python $version (torch is large: a few minutes)"
   .venv/bin/python -m pip install -q --upgrade pip >/dev/null
-  .venv/bin/python -m pip install -q -e '.[dev]'
+  # the versions the docs' datasets were made with, where pinned for this Python: the same
+  # config and seed then give the docs' bytes (Parquet and PNG bytes follow library versions)
+  if [ -f "$pins" ]; then
+    .venv/bin/python -m pip install -q -c "$pins" -e '.[dev]'
+  else
+    echo "setup: no pinned versions for Python $version ($pins): installing the newest allowed; datasets may differ in bytes from the docs' (docs/scale.md)"
+    .venv/bin/python -m pip install -q -e '.[dev]'
+  fi
   # pyrender 0.1.45 pins PyOpenGL 3.1.0, whose ctypes array handlers break glGenTextures on
   # Python 3.12+ (textured rendering fails); 3.1.10 works on 3.11-3.13 and renders the same
   # bytes (checked with llvmpipe EGL). Installed over the pin on every Python, so all match
