@@ -125,10 +125,8 @@ class MethodLocalizer:
 
     def score(self, a: np.ndarray, b: np.ndarray) -> np.ndarray:
         """(P,) similarity of the row pairs (a[k], b[k]) of :meth:`embed`'s vectors."""
-        ta, tb = (
-            torch.from_numpy(np.ascontiguousarray(a)),
-            torch.from_numpy(np.ascontiguousarray(b)),
-        )
+        # a map's rows are read-only (torch warns on those): copied only where needed
+        ta, tb = (torch.from_numpy(np.require(x, requirements=["C", "W"])) for x in (a, b))
         if self._similarity is None:
             return (ta * tb).sum(1).double().numpy()
         with torch.no_grad():

@@ -4,6 +4,7 @@ registers, and the one-line refusal of a method that breaks a check (no partial 
 from __future__ import annotations
 
 import json
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -259,6 +260,12 @@ def test_a_method_localizes_views_for_maps_and_navigation(mini_dataset: Path) ->
         (boxes.score(box_vectors, box_vectors[::-1]) >= 0)
         & (boxes.score(box_vectors, box_vectors) <= 1)
     ).all()
+    frozen = box_vectors.copy()
+    frozen.setflags(write=False)  # a map's rows, as they come from its file
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # torch warns (once a process) on read-only arrays
+        scores = boxes.score(frozen, frozen[::-1])
+    assert np.array_equal(scores, boxes.score(box_vectors, box_vectors[::-1]))
     register_method("test-bad-localizer")(_NaN)
     with pytest.raises(MethodError, match="test-bad-localizer.*check: finite"):
         MethodLocalizer("test-bad-localizer").embed([views[0].view])
