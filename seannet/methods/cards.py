@@ -90,6 +90,16 @@ def _interval(entry: dict[str, float]) -> str:
     return pct(entry["mean"]) + (f" ± {pct(half)}" if not math.isnan(half) else "")
 
 
+def _breaks(summary: dict[str, Any], measure: str) -> str:
+    """Where the method breaks along ``measure``, or "never" with its accuracy in the sweep's
+    last bin that holds triplets (how far the data's change reached, and what it cost)."""
+    at = summary["breaks_at"].get(measure)
+    if at:
+        return str(at)
+    held = [(b, v) for b, v in summary["change"][measure].items() if v["triplets"]]
+    return f"never ({held[-1][0]}: {pct(held[-1][1]['accuracy'])} %)" if held else "never"
+
+
 def _markdown(card: dict[str, Any]) -> str:
     s = card["summary"]
     kind = f"trained, {s['seeds']} seeds" if card["trained"] else "no training"
@@ -106,7 +116,7 @@ def _markdown(card: dict[str, Any]) -> str:
         f"- cost: {s['ms_per_view']:.2f} ms per view embedded, {s['bytes_per_map_entry']} bytes "
         "per map entry",
         "- breaks at (first bin below halfway from its no-change accuracy to chance): "
-        + ", ".join(f"{m.replace('_', ' ')} {b or 'never'}" for m, b in s["breaks_at"].items()),
+        + ", ".join(f"{m.replace('_', ' ')} {_breaks(s, m)}" for m in s["breaks_at"]),
         "",
         "Accuracy per tier (%):",
         "",
@@ -260,7 +270,7 @@ def leaderboard(cards: list[dict[str, Any]]) -> str:
                 _interval(c["summary"]["accuracy_rooms_seeds"]),
                 _interval(c["summary"]["recall1"]),
                 _interval(c["summary"]["recall5"]),
-                c["summary"]["breaks_at"].get("moved_objects") or "never",
+                _breaks(c["summary"], "moved_objects"),
                 f"{c['summary']['ms_per_view']:.2f}",
                 str(c["summary"]["bytes_per_map_entry"]),
                 _navigation_cell(c),

@@ -184,6 +184,22 @@ def test_reference_methods_get_cards_and_a_leaderboard(tmp_path: Path, mini_data
     assert "`tiny-image`" in table and "`boxes-overlap`" in table
 
 
+def test_the_leaderboard_says_where_a_method_breaks_or_how_far_the_change_reached() -> None:
+    from seannet.methods.benchmark import breaking_point
+    from seannet.methods.cards import _breaks
+
+    bins = {"0": (0.9, 50), "1": (0.85, 40), "2": (0.6, 30), "3-5": (0.55, 20), "6+": (float("nan"), 0)}
+    change = {"moved_objects": {b: {"accuracy": a, "triplets": n} for b, (a, n) in bins.items()}}
+    summary = {"change": change, "breaks_at": {"moved_objects": None}}
+    summary["breaks_at"]["moved_objects"] = breaking_point(change["moved_objects"])
+    assert _breaks(summary, "moved_objects") == "2"  # 60 % < halfway from 90 % to chance (70)
+    change["moved_objects"]["2"]["accuracy"] = 0.8
+    change["moved_objects"]["3-5"]["accuracy"] = 0.75
+    summary["breaks_at"]["moved_objects"] = breaking_point(change["moved_objects"])
+    # 6+ holds no triplet: the change reached 3-5 objects, at 75 %
+    assert _breaks(summary, "moved_objects") == "never (3-5: 75.0 %)"
+
+
 def test_a_bundled_network_trains_per_seed(tmp_path: Path, mini_dataset: Path) -> None:
     config = BenchmarkConfig(seeds=(0, 1), batch_size=16, batches=1, epochs=1, noise=())
     card = json.loads(
