@@ -65,8 +65,18 @@ class ProcessState:
             if head:
                 commit = head
                 dirty = bool(_git(checkout, "status", "--porcelain", "--untracked-files=no"))
-        command = shlex.join(sys.argv if argv is None else argv)
+        command = shlex.join(_program_named(list(sys.argv if argv is None else argv)))
         return cls(commit=commit, dirty=dirty, command=command, loaded=_utc_now())
+
+
+def _program_named(argv: list[str]) -> list[str]:
+    """``argv`` with a console script of this interpreter's environment named as typed
+    (``seannet``, not ``/home/me/repo/.venv/bin/seannet``): the stamp should not carry the
+    user's directories, and the name is what a reader types."""
+    program = Path(argv[0]) if argv else None
+    if program and program.is_absolute() and program.parent == Path(sys.executable).parent:
+        return [program.name, *argv[1:]]
+    return argv
 
 
 def _git(checkout: Path, *args: str) -> str:

@@ -75,6 +75,10 @@ def test_the_commit_is_the_one_loaded_not_the_one_at_write_time(tmp_path: Path) 
     (repo / "f").write_text("3")
     assert ProcessState.capture(repo).dirty
     assert ProcessState.capture(tmp_path / "nowhere").commit == "unknown"
+    installed = str(Path(sys.executable).parent / "seannet")
+    assert ProcessState.capture(repo, argv=[installed, "eval"]).command == "seannet eval"
+    elsewhere = str(tmp_path / "bin" / "seannet")
+    assert ProcessState.capture(repo, argv=[elsewhere, "eval"]).command == f"{elsewhere} eval"
 
 
 def test_importing_seannet_reads_the_commit_once() -> None:
