@@ -200,6 +200,13 @@ def test_the_leaderboard_says_where_a_method_breaks_or_how_far_the_change_reache
     assert _breaks(summary, "moved_objects") == "never (3-5: 75.0 %)"
 
 
+def test_the_docs_leaderboard_is_its_cards() -> None:
+    docs = Path(__file__).parents[3] / "docs"
+    assert (docs / "leaderboard.md").read_text() == leaderboard(read_cards([docs / "cards"])), (
+        "docs/leaderboard.md: run `seannet leaderboard docs/cards --out docs/leaderboard.md`"
+    )
+
+
 def test_a_bundled_network_trains_per_seed(tmp_path: Path, mini_dataset: Path) -> None:
     config = BenchmarkConfig(seeds=(0, 1), batch_size=16, batches=1, epochs=1, noise=())
     card = json.loads(
