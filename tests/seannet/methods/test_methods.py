@@ -188,7 +188,13 @@ def test_the_leaderboard_says_where_a_method_breaks_or_how_far_the_change_reache
     from seannet.methods.benchmark import breaking_point
     from seannet.methods.cards import _breaks
 
-    bins = {"0": (0.9, 50), "1": (0.85, 40), "2": (0.6, 30), "3-5": (0.55, 20), "6+": (float("nan"), 0)}
+    bins = {
+        "0": (0.9, 50),
+        "1": (0.85, 40),
+        "2": (0.6, 30),
+        "3-5": (0.55, 20),
+        "6+": (float("nan"), 0),
+    }
     change = {"moved_objects": {b: {"accuracy": a, "triplets": n} for b, (a, n) in bins.items()}}
     summary = {"change": change, "breaks_at": {"moved_objects": None}}
     summary["breaks_at"]["moved_objects"] = breaking_point(change["moved_objects"])
