@@ -6,8 +6,8 @@
 Whether the results' aims are a matter of compute: SeanNet (``seannet-fc512``, the ``cpu``
 preset's network), ``resnet18+boxes`` and ``seannet-fc512+box-kernel`` trained at growing
 budgets (seconds of one thread's compute per run, :mod:`seannet.training.budget`: 300 bought
-seannet-fc512 7 batches per epoch on the docs' machine, where the old ``--budget 150`` had bought
-35). The protocol (DESIGN §12):
+seannet-fc512 7 batches per epoch on the machine of 2026-12-02 and 19 on that of 2026-12-03;
+the page's tables say what each network got). The protocol (DESIGN §12):
 
 - the first budget is a ``seannet compare``: each network calibrated to it, the lr chosen on
   val among {0.003, 0.01} with the first seed, then its seeds;
@@ -190,16 +190,20 @@ def _lr(point: dict[str, Any], k: int) -> str:
 
 
 def _flattens(points: list[dict[str, Any]]) -> str:
-    """Where val accuracy stops gaining a point per budget step (read on val, not test)."""
-    for before, after in zip(points, points[1:], strict=False):
-        if after["val"]["mean"] - before["val"]["mean"] < 0.01:
-            return (
-                f"flat from {before['budget_s']:g} s "
-                f"(val gains < 1 point to {after['budget_s']:g} s)"
-            )
+    """Where val accuracy stops gaining a point per budget step (read on val, not test), with
+    each step's val gain in points."""
     if len(points) < 2:
         return "one budget only"
-    return f"still rising at {points[-1]['budget_s']:g} s (val)"
+    pairs = list(zip(points, points[1:], strict=False))
+    gains = [100 * (after["val"]["mean"] - before["val"]["mean"]) for before, after in pairs]
+    steps = "; ".join(
+        f"{before['budget_s']:g} to {after['budget_s']:g} s: {gain:+.1f}"
+        for (before, after), gain in zip(pairs, gains, strict=True)
+    )
+    for (before, _), gain in zip(pairs, gains, strict=True):
+        if gain < 1.0:
+            return f"flat from {before['budget_s']:g} s (val gains, points: {steps})"
+    return f"still rising at {points[-1]['budget_s']:g} s (val gains, points: {steps})"
 
 
 def tables(runs: Path, plot: Path) -> str:

@@ -9,8 +9,9 @@ step and call, and runs each step:
 
 - ``headline``: ``seannet compare`` of SeanNet, ``resnet18+boxes`` and ResNet-18, 3 seeds,
   lr from {0.003, 0.01} on val, ``--budget`` seconds of one thread's compute per run (300
-  bought seannet-fc512 7 batches per epoch on the docs' machine, the old 150 had bought 35:
-  1,200 is the nearer match; the protocol: selection.json before test);
+  bought seannet-fc512 7 batches per epoch on the machine of 2026-12-02, 19 on that of
+  2026-12-03, the old 150 had bought 35: docs/learning-curve.md says which budget val
+  favours; the protocol: selection.json before test);
 - ``noise``: the headline models' chosen runs evaluated on test under labeler / detector box
   noise (every choice, epsilon and lambda, re-read on val under the same noise);
 - ``ablations``: SeanNet's image branch alone, the paper's graph branch (no layout pathway)

@@ -19,8 +19,10 @@ On a GPU the steps are timed on the wall clock (after a synchronise): the GPU is
 The seconds are one thread's, whatever threads the run itself will use: a run on two cores
 trains its budget in about half the wall time. A budget buys far fewer batches than the same
 number bought when the calibration divided process time by torch's threads: 300 s of one
-thread bought seannet-fc512 7 batches per epoch on the docs' machine (a step 7.5 s,
-2026-12-02), where the old 150 had recorded 35; 1,200 s (28) is the nearer match.
+thread bought seannet-fc512 7 batches per epoch on the docs' machine of 2026-12-02 (a step
+7.5 s), where the old 150 had recorded 35. Seconds are the machine's own: on the machine of
+2026-12-03 a step took 3.1 s and 300 s bought 19 batches, so runs on two machines are
+compared by their recorded batches, not by their budgets.
 
 The calibration is a measurement, so two on the same machine may differ by a few per cent:
 what a run got is recorded (:meth:`Calibration.to_dict`, in ``selection.json``) and reused,

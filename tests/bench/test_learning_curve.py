@@ -53,3 +53,21 @@ def test_budgets_are_refused_with_one_line() -> None:
         curve.parse_budgets("300,1200")
     with pytest.raises(SystemExit, match="seeds >= 1"):
         curve.parse_budgets("300:0")
+
+
+def test_where_a_curve_flattens_is_read_on_val() -> None:
+    curve = load_bench("learning_curve")
+
+    def point(budget: float, val: float, test: float) -> dict:
+        return {"budget_s": budget, "val": {"mean": val}, "test": {"mean": test}}
+
+    # test rises, val does not: flat, since nothing is read on test
+    flat = [point(300, 0.840, 0.80), point(1200, 0.845, 0.90), point(4800, 0.90, 0.95)]
+    assert curve._flattens(flat) == (
+        "flat from 300 s (val gains, points: 300 to 1200 s: +0.5; 1200 to 4800 s: +5.5)"
+    )
+    rising = [point(300, 0.80, 0.8), point(1200, 0.82, 0.8)]
+    assert curve._flattens(rising) == (
+        "still rising at 1200 s (val gains, points: 300 to 1200 s: +2.0)"
+    )
+    assert curve._flattens(rising[:1]) == "one budget only"
