@@ -170,7 +170,9 @@ def read_curve(runs: Path) -> dict[str, list[dict[str, Any]]]:
                 "val": t_interval([r["val"] for r in mine]),
                 "test": t_interval([r["test"] for r in mine]),
             })  # fmt: skip
-    return points
+    # the design's order, whichever call evaluated a model last
+    order = {m: k for k, m in enumerate(MODELS)}
+    return dict(sorted(points.items(), key=lambda item: order.get(item[0], len(order))))
 
 
 def _cell(interval: dict[str, float]) -> str:
