@@ -7,26 +7,28 @@
 and format version) to ``RUNS/provenance.jsonl`` (:mod:`seannet.provenance`), one record per
 step and call, and runs each step:
 
-- ``headline``: ``seannet compare`` of SeanNet, ``resnet18+boxes`` and ResNet-18, 3 seeds,
+- ``headline``: ``seannet compare`` of SeanNet (the ``cpu`` preset's network,
+  ``seannet-fc512``), ``resnet18+boxes`` and ResNet-18, 3 seeds,
   lr from {0.003, 0.01} on val, ``--budget`` seconds of one thread's compute per run (300
   bought seannet-fc512 7 batches per epoch on the machine of 2026-12-02, 19 on that of
   2026-12-03, the old 150 had bought 35: docs/learning-curve.md says which budget val
   favours; the protocol: selection.json before test);
 - ``noise``: the headline models' chosen runs evaluated on test under labeler / detector box
   noise (every choice, epsilon and lambda, re-read on val under the same noise);
-- ``ablations``: SeanNet's image branch alone, the paper's graph branch (no layout pathway)
-  and graph-only, under the same selection and the same budget rule: a network calibrated in
-  an earlier step of ``RUNS`` under the same budget and clock keeps its batches (SeanNet's
-  runs are then the headline's), every other one is calibrated alike;
+- ``ablations``: the paper's SeanNet (``seannet``, GCN fc 4,096) against its image branch
+  alone, its graph branch without the layout pathway and graph-only, under the same
+  selection and the same budget rule: a network calibrated in an earlier step of ``RUNS``
+  under the same budget and clock keeps its batches (``seannet``'s runs are then the fc
+  step's), every other one is calibrated alike;
 - ``boxes``: SeanNet plus the hand-made box overlap (lambda on val) against SeanNet: whether
   the overlap still adds what SeanNet's layout pathway should have learned; the lr is the
   headline SeanNet's (chosen on val there), so both rows are the headline's runs, evaluated
   again;
 - ``kernel``: the box kernel learned on the train triplets (``+box-kernel``) on SeanNet and
   ResNet-18, against the hand-made overlap on each (evaluations only);
-- ``fc``: SeanNet with a 512-wide GCN fc (``seannet-fc512``) against the paper's 4,096,
-  under the same budget rule as ``ablations``: what the narrower fc, whose step is near
-  ResNet-18's, costs or gains under the same budget;
+- ``fc``: SeanNet with a 512-wide GCN fc (``seannet-fc512``, the headline's runs) against
+  the paper's 4,096 (``seannet``), under the same budget rule as ``ablations``: what the
+  narrower fc, whose step is near ResNet-18's, costs or gains under the same budget;
 - ``fullmap``: recall of the true pose among every sub-node of a test room's map at spacing 1
   (every reachable cell x 4 headings of layout 0, rendered live), queries from the other
   layouts, for the headline's SeanNet and ResNet-18 (seed 0's run: a map is rendered per run).
@@ -60,21 +62,24 @@ from seannet.navigation.localizer import load_localizer  # noqa: E402
 from seannet.navigation.map_localization import run_localize  # noqa: E402
 from seannet.navigation.maps import build_maps  # noqa: E402
 from seannet.provenance import append_provenance, read_provenance, stamp  # noqa: E402
-from seannet.training.config import TrainConfig  # noqa: E402
+from seannet.training.config import TrainConfig, preset  # noqa: E402
 from sgdata.fileio import atomic_write_text  # noqa: E402
 
 SEEDS = (0, 1, 2)
 LRS = (0.003, 0.01)
-HEADLINE = ("seannet", "resnet18+boxes", "resnet18")
+# SeanNet as the toolkit trains it on a CPU: the `cpu` preset's network (the paper's GCN fc
+# 4,096 wide is `seannet`, measured against it in the fc step and ablated in its branches)
+SEANNET = preset("cpu").model.name
+HEADLINE = (SEANNET, "resnet18+boxes", "resnet18")
 ABLATIONS = ("seannet", "seannet-image", "seannet-nolayout", "seannet-graph")
 # does the hand-made overlap still add to SeanNet? (if so, its layout pathway has not learned
 # what the boxes hold); the runs are the headline's: evaluations only
-BOXES = ("seannet+boxes", "seannet")
+BOXES = (f"{SEANNET}+boxes", SEANNET)
 # a learned scene term against the hand-made overlap, on both networks
-KERNEL = ("seannet+box-kernel", "resnet18+boxes", "seannet+boxes", "resnet18+box-kernel")
-# the GCN fc 512 wide instead of the paper's 4,096: a CPU step near ResNet-18's (what each
-# got under the same budget: the fc section's budget table)
-FC = ("seannet-fc512", "seannet")
+KERNEL = (f"{SEANNET}+box-kernel", "resnet18+boxes", f"{SEANNET}+boxes", "resnet18+box-kernel")
+# the paper's GCN fc (4,096 wide) against the cpu preset's 512 under the same budget rule
+# (what each got: the fc section's budget table)
+FC = (SEANNET, "seannet")
 COMPARISONS = {
     "headline": HEADLINE,
     "ablations": ABLATIONS,
@@ -86,8 +91,8 @@ COMPARISONS = {
 # aim's point S = 0.05, P = 0.1 (all seeds there; seed 0 elsewhere)
 NOISE_GRID = ((0.02, 0.0), (0.05, 0.0), (0.1, 0.0), (0.0, 0.1), (0.0, 0.25), (0.05, 0.1))
 AIM = (0.05, 0.1)
-NOISE_MODELS = ("seannet", "resnet18+boxes")
-FULL_MAP_MODELS = ("seannet", "resnet18")
+NOISE_MODELS = (SEANNET, "resnet18+boxes")
+FULL_MAP_MODELS = (SEANNET, "resnet18")
 FULL_MAP = "localize_test.json"  # what `seannet localize --split test` writes per run
 
 
@@ -116,7 +121,7 @@ def run_step(
     step trains at the headline SeanNet's lr, so its rows are the headline's runs."""
     if step in COMPARISONS:
         if step == "boxes":
-            lrs = (_headline_lr(runs, "seannet"),)
+            lrs = (_headline_lr(runs, SEANNET),)
         compare_models(
             data,
             runs,
@@ -464,7 +469,7 @@ def _reading(runs: Path, result: dict[str, Any]) -> list[str]:
     by = {e["model"]: e for e in result["models"]}
     lines = []
     for name, e in by.items():
-        if name == "seannet":
+        if name == SEANNET:
             continue
         d = e["difference_to_first"]
         lines.append(
@@ -474,7 +479,7 @@ def _reading(runs: Path, result: dict[str, Any]) -> list[str]:
     stds = ", ".join(
         f"{name} {100 * e['summary']['accuracy']['std']:.1f}" for name, e in by.items()
     )
-    seeds = by["seannet"]["summary"]["accuracy"]["n"]
+    seeds = by[SEANNET]["summary"]["accuracy"]["n"]
     lines.append(f"- Seed-to-seed spread (std over {seeds} seeds, points): {stds}.")
     for name in NOISE_MODELS:
         if name in by and _aim_losses(runs, result, name):
@@ -503,7 +508,7 @@ def _full_map_results(runs: Path) -> dict[str, list[dict[str, Any]]]:
 
 
 def _full_map_aim(runs: Path) -> str:
-    seannet = _full_map_results(runs).get("seannet")
+    seannet = _full_map_results(runs).get(SEANNET)
     if not seannet:
         return "| full-map recall@1 >= 90 % | not measured (below) | - |"
     recall = sum(r["recall@1"] for r in seannet) / len(seannet)
@@ -616,8 +621,8 @@ def tables(runs: Path) -> str:
     """docs/results.md from the run files under ``runs``."""
     head = json.loads((runs / "comparison-headline.json").read_text())
     models = {e["model"]: e for e in head["models"]}
-    ours = models["seannet"]["summary"]
-    baselines = [e for e in head["models"] if e["model"] != "seannet"]
+    ours = models[SEANNET]["summary"]
+    baselines = [e for e in head["models"] if e["model"] != SEANNET]
     strongest = max(baselines, key=_val_accuracy)  # chosen on val, as every choice
     gap = strongest["difference_to_first"]
     out = [
@@ -630,7 +635,9 @@ def tables(runs: Path) -> str:
         "row, intervals over rooms and seeds. The data is `medium` of today's generator "
         "(textures, per-layout light and looks, lived-in layouts) drawn with a dataset seed "
         "no earlier figure or design choice used (`configs/results.toml`): its "
-        f"{ours['rooms']} test rooms never informed the model.",
+        f"{ours['rooms']} test rooms never informed the model. SeanNet here is `{SEANNET}`, "
+        "the network the `cpu` preset trains (the paper's GCN fc, 4,096 wide, is `seannet`: "
+        "the fc section below).",
         "",
         *_stamp(runs, "headline"),
         "## Headline",
@@ -653,8 +660,8 @@ def tables(runs: Path) -> str:
         f"| >= +3 points over the strongest baseline ({strongest['model']}), interval clear "
         f"of 0 | {_span(gap, True)} | "
         f"{'yes' if gap['mean'] >= 0.03 and gap['low'] > 0 else 'no'} |",
-        f"| loses <= 3 points at S = 0.05, P = 0.1 | {_noise_loss(runs, head, 'seannet')} | "
-        f"{_noise_met(runs, head, 'seannet')} |",
+        f"| loses <= 3 points at S = 0.05, P = 0.1 | {_noise_loss(runs, head, SEANNET)} | "
+        f"{_noise_met(runs, head, SEANNET)} |",
         _full_map_aim(runs),
         *_kernel_aims(runs),
         "",
@@ -696,9 +703,10 @@ def tables(runs: Path) -> str:
         runs,
         "ablations",
         "Ablations: what each branch adds, under the same selection",
+        "On the paper's SeanNet (`seannet`, GCN fc 4,096). "
         "`seannet-image`: the image branch alone; `seannet-nolayout`: the paper's graph "
         "branch (GCN pathways, no layout pathway); `seannet-graph`: no image vector in "
-        "the fusion. The same budget rule as SeanNet's: a network calibrated in an earlier "
+        "the fusion. The same budget rule as the headline's: a network calibrated in an earlier "
         "step under the same budget keeps its batches, the others are calibrated alike.",
     )
     out += _comparison_section(
@@ -711,21 +719,11 @@ def tables(runs: Path) -> str:
         "The batch counts below say how far the budget's calibrations put the two apart.",
     )
     out += CURVE_SECTION
-    ablations = runs / "comparison-ablations.json"
-    missing = (
-        []
-        if ablations.exists()
-        else [
-            "- The ablations (image branch alone, the paper's graph branch, graph-only) under the "
-            "same selection: `python bench/results.py run DATA RUNS --steps ablations`; not "
-            "run for this set."
-        ]
-    )
     out += [
         "",
         "## Not measured in this set of runs",
         "",
-        *missing,
+        *_steps_not_run(runs, head),
         *_not_on_gpu(runs),
         *NOT_MEASURED,
         "",
@@ -758,6 +756,36 @@ NOT_MEASURED = [
     "full-map recall with a scene term (the fullmap step maps the headline's SeanNet and "
     "ResNet-18 only).",
 ]
+
+
+# what each step after the headline measures, for the list of steps a set of runs lacks
+LATER_STEPS = {
+    "noise": "The headline's models under labeler / detector box noise",
+    "boxes": "SeanNet plus the hand-made overlap",
+    "fullmap": "Full-map recall",
+    "kernel": "The learned box kernel",
+    "fc": "The paper's GCN fc (4,096 wide) against the cpu preset's",
+    "ablations": "The ablations (image branch alone, the paper's graph branch, graph-only)",
+}
+
+
+def _step_ran(runs: Path, step: str, head: dict[str, Any]) -> bool:
+    if step == "noise":
+        shown = {e["model"] for e in head["models"]}
+        return any(_aim_losses(runs, head, m) for m in NOISE_MODELS if m in shown)
+    if step == "fullmap":
+        return bool(_full_map_results(runs))
+    return (runs / f"comparison-{step}.json").exists()
+
+
+def _steps_not_run(runs: Path, head: dict[str, Any]) -> list[str]:
+    """A line per step of :data:`LATER_STEPS` without results under ``runs`` (read from the
+    files, so a set run in parts says what it still lacks)."""
+    return [
+        f"- {what}: `python bench/results.py run DATA RUNS --steps {step}`; not run for this set."
+        for step, what in LATER_STEPS.items()
+        if not _step_ran(runs, step, head)
+    ]
 
 
 def _not_on_gpu(runs: Path) -> list[str]:

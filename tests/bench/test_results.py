@@ -58,8 +58,14 @@ def test_tables_are_the_runs_figures(
     # the noise table holds the aim's point on every seed of both models
     noise_rows = [line for line in doc.splitlines() if "(n=2)" in line]
     assert len(noise_rows) == 2 and all("points |" in line for line in noise_rows)
-    assert "## Ablations" not in doc  # not run: not printed
+    assert "## Ablations" not in doc  # not run: not printed, but named as missing
     assert "## A learned scene term" not in doc
+    assert "--steps kernel`; not run for this set" in doc
+    assert "--steps ablations`; not run for this set" in doc
+    assert "--steps noise`" not in doc  # the noise step ran
+    # SeanNet is the network the cpu preset trains, and the doc says which
+    assert results.HEADLINE[0] == results.SEANNET == "seannet-fc512"
+    assert "SeanNet here is `seannet-fc512`" in doc
     # the learned scene term: the headline's runs evaluated again, its section computed
     kernel = compare_models(
         mini_dataset,
@@ -71,20 +77,20 @@ def test_tables_are_the_runs_figures(
         tag="kernel",
     )
     assert {Path(r["run"]).parent.parent.name for m in kernel["models"] for r in m["runs"]} == {
-        "seannet",
+        results.SEANNET,
         "resnet18",
     }
     append_provenance(runs, mini_dataset, step="kernel")
     doc = results.tables(runs)
-    assert "## A learned scene term" in doc
+    assert "## A learned scene term" in doc and "--steps kernel`" not in doc
     ours = kernel["models"][0]["summary"]["accuracy"]["mean"]
     assert (
-        f"| seannet+box-kernel (the learned scene term, below) >= 90 % | {100 * ours:.1f} %" in doc
+        f"| {results.KERNEL[0]} (the learned scene term, below) >= 90 % | {100 * ours:.1f} %" in doc
     )
     for entry in kernel["models"][1:]:
         d = entry["difference_to_first"]
         assert (
-            f"seannet+box-kernel minus {entry['model']}: {100 * d['mean']:+.1f} "
+            f"{results.KERNEL[0]} minus {entry['model']}: {100 * d['mean']:+.1f} "
             f"[{100 * d['low']:+.1f}, {100 * d['high']:+.1f}]"
         ) in doc
     # full-map recall: maps rendered at spacing 1, each model's figures from its localize file

@@ -25,10 +25,11 @@ def test_sections_compare_like_for_like(
 ) -> None:
     results = load_bench("results")
     runs = tmp_path / "runs"
+    ours = results.SEANNET
     steps = {
-        "headline": ("seannet", "resnet18"),
+        "headline": (ours, "resnet18"),
         "boxes": None,  # the step's own models
-        "ablations": ("seannet", "seannet-image"),
+        "ablations": (ours, "seannet-image"),
     }
     for step, models in steps.items():
         append_provenance(runs, mini_dataset, step=step)
@@ -47,24 +48,22 @@ def test_sections_compare_like_for_like(
     }
     boxes = json.loads((runs / "selection-boxes.json").read_text())
     # the boxes step trains at the headline SeanNet's lr only: both rows are its runs
-    assert boxes["lrs"] == [head["seannet"]["lr"]]
-    assert all(m["runs"] == head["seannet"]["runs"] for m in boxes["models"])
+    assert boxes["lrs"] == [head[ours]["lr"]]
+    assert all(m["runs"] == head[ours]["runs"] for m in boxes["models"])
     # the ablations' SeanNet keeps the headline's calibrated batches; the image branch is
     # calibrated by the same rule under the same budget
     ablations = {
         m["model"]: m for m in json.loads((runs / "selection-ablations.json").read_text())["models"]
     }
-    assert ablations["seannet"]["budget"]["source"] == "recorded"
-    assert ablations["seannet"]["batches_per_epoch"] == head["seannet"]["budget"]["batches"]
+    assert ablations[ours]["budget"]["source"] == "recorded"
+    assert ablations[ours]["batches_per_epoch"] == head[ours]["budget"]["batches"]
     assert ablations["seannet-image"]["budget"]["source"] == "calibrated"
     assert ablations["seannet-image"]["budget"]["budget_s"] == BUDGET_S
 
     doc = results.tables(runs)
     section = _section(doc, "SeanNet plus the hand-made overlap")
-    assert (
-        "seannet+boxes: the headline seannet's runs; seannet: the headline seannet's runs"
-        in section
-    )
+    headline_runs = f"the headline {ours}'s runs"
+    assert f"{ours}+boxes: {headline_runs}; {ours}: {headline_runs}" in section
     section = _section(doc, "Ablations")
     for name, entry in ablations.items():
         row = (
@@ -72,7 +71,7 @@ def test_sections_compare_like_for_like(
             f"{entry['examples']:,} |"
         )
         assert row in section
-    assert "| seannet | seannet | " in section and "calibrated in `headline`" in section
+    assert f"| {ours} | {ours} | " in section and "calibrated in `headline`" in section
     assert f"Like for like: every network's batches fill the same {BUDGET_S:g} s" in section
 
     # a section whose runs are not the headline's says so, and names why
@@ -84,8 +83,8 @@ def test_sections_compare_like_for_like(
         r["run"] = r["run"].replace("/lr", "/other-lr")
     path.write_text(json.dumps(tampered))
     section = _section(results.tables(runs), "SeanNet plus the hand-made overlap")
-    assert "the headline seannet's runs" in section  # the untouched row
-    assert "seannet+boxes: not the headline seannet's runs (lr 0.1 against" in section
+    assert f"the headline {ours}'s runs" in section  # the untouched row
+    assert f"{ours}+boxes: not the headline {ours}'s runs (lr 0.1 against" in section
 
     # runs made before budgets were recorded: "not recorded", and no like-for-like claim
     path = runs / "comparison-ablations.json"
@@ -96,5 +95,5 @@ def test_sections_compare_like_for_like(
     (runs / "selection-ablations.json").write_text(json.dumps(old | {"split": None}))
     section = _section(results.tables(runs), "Ablations")
     assert section.count("| not recorded |") == len(old["models"])
-    assert "Like for like not shown: seannet, seannet-image have no budget record" in section
+    assert f"Like for like not shown: {ours}, seannet-image have no budget record" in section
     assert "Like for like: every" not in section
