@@ -8,7 +8,9 @@ The protocol (DESIGN §12), in the order it runs:
    thread (:mod:`seannet.training.budget`: the machine's load does not change it); what the
    budget bought (batches, triplets, the timing's spread) is recorded in the selection, a
    spread above :data:`~seannet.training.budget.SPREAD_WARNING` is announced as a warning,
-   and a rerun with the recorded figures trains exactly the same.
+   and a rerun with the recorded figures trains exactly the same. Each calibration is kept
+   in ``calibrations.json`` before any run trains, so a comparison resumed (on this machine
+   or another) trains the batches its runs began with.
 2. **Selection, on val only.** For each learning rate of ``lrs``, seed 0 is trained and its
    best epoch (per-epoch val) is evaluated on the *whole* val split; the lr with the best val
    accuracy is chosen (ties: the smaller), and the other seeds are trained at it. A
@@ -55,15 +57,17 @@ from seannet.evaluation.intervals import (
 )
 from seannet.evaluation.run_eval import evaluate_run
 from seannet.model.specs import parse_spec
+from seannet.provenance import provenance_record
 from seannet.training.budget import Calibration, calibrate
 from seannet.training.config import TrainConfig
 from seannet.training.config import preset as load_preset
-from seannet.training.runs import LAST
+from seannet.training.runs import LAST, device_for_run
 from seannet.training.train import train
 from sgdata.dataset import Dataset
 from sgdata.fileio import atomic_write_text
 
 __all__ = [
+    "CALIBRATIONS",
     "COMPARISON",
     "SELECTION",
     "ModelSpec",
@@ -74,6 +78,7 @@ __all__ = [
 ]
 
 COMPARISON = "comparison"  # comparison.json and comparison.md under the output directory
+CALIBRATIONS = "calibrations.json"  # the budget's calibrations of the runs under it, reused
 SELECTION = "selection.json"  # every choice, written before any test row is read
 
 
@@ -134,9 +139,9 @@ def compare_models(
             is read.
         tag: names this comparison's files (``selection-<tag>.json``, ...), so comparisons of
             different model sets can share one ``out`` and its runs.
-        batches: batches per epoch by trained network, as an earlier comparison on ``out``
-            recorded them (a calibration is timed, so a second one may differ by a batch and
-            the runs would not resume); the others are calibrated to ``budget_s``.
+        batches: batches per epoch by trained network, as an earlier comparison recorded
+            them (its selection); the others are calibrated to ``budget_s``, or take the
+            calibration ``out/calibrations.json`` keeps of them.
 
     Raises:
         ModelError: no model or no seed named, or a bad spec.
@@ -154,7 +159,9 @@ def compare_models(
         config = spec.config
         if budget_s is not None or spec.trained in batches:
             if spec.trained not in batches:
-                calibrations[spec.trained] = _calibrate(spec.trained, config, ds, budget_s, say)
+                calibrations[spec.trained] = _calibration(
+                    spec.trained, config, ds, out, budget_s, say
+                )
                 batches[spec.trained] = calibrations[spec.trained].batches
             config = config.replace(max_train_batches=batches[spec.trained])
         choice = _select(spec, config, ds, out, seeds, lrs or (config.lr,), say)
@@ -228,6 +235,46 @@ def _select(
         "examples": config.max_train_batches * config.batch_size * config.epochs,
         "runs": runs,
     }
+
+
+def _calibration(
+    trained: str,
+    config: TrainConfig,
+    ds: Dataset,
+    out: Path,
+    budget_s: float,
+    say: Callable[[str], None],
+) -> Calibration:
+    """The calibration that sets ``trained``'s batches for the runs under ``out``.
+
+    The first one taken is kept in ``out/calibrations.json`` (before any run trains) and
+    reused by every later call with the same network, budget and step shape: a comparison
+    resumed, maybe on another machine, must train the batches its runs began with, and a
+    second timing differs (by a few per cent on one machine, by half on another)."""
+    path = out / CALIBRATIONS
+    records = json.loads(path.read_text()) if path.exists() else []
+    key = {
+        "trained": trained,
+        "budget_s": float(budget_s),
+        "batch_size": config.batch_size,
+        "epochs": config.epochs,
+        "image_size": config.model.image_size,
+        "device": device_for_run().type,
+    }
+    for record in records:
+        if record["key"] == key:
+            got = Calibration.from_dict(record["calibration"])
+            say(
+                f"{trained}: {got.batches} batches per epoch, as calibrated for these runs at "
+                f"{record['taken']['started']} (a step {got.step_s:.3f} s; {path})"
+            )
+            return got
+    got = _calibrate(trained, config, ds, budget_s, say)
+    taken = provenance_record(None, step="calibrate")  # when, by which code and command
+    records.append({"key": key, "taken": taken, "calibration": got.to_dict()})
+    out.mkdir(parents=True, exist_ok=True)
+    atomic_write_text(path, json.dumps(records, indent=2))
+    return got
 
 
 def _calibrate(

@@ -89,6 +89,11 @@ class Calibration:
         """Plain form for ``selection.json``."""
         return {**asdict(self), "steps_s": list(self.steps_s)}
 
+    @classmethod
+    def from_dict(cls, record: dict[str, Any]) -> Calibration:
+        """The calibration :meth:`to_dict` wrote."""
+        return cls(**{**record, "steps_s": tuple(record["steps_s"])})
+
 
 @contextmanager
 def _one_thread() -> Iterator[None]:
