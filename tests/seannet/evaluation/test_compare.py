@@ -13,6 +13,7 @@ import torch
 
 from seannet.errors import ModelError
 from seannet.evaluation.compare import (
+    CALIBRATIONS,
     SELECTION,
     compare_models,
     model_spec,
@@ -102,6 +103,39 @@ def test_compare_selects_on_val_before_reading_test(tmp_path: Path, mini_dataset
     assert difference["high"] >= welch["high"] - 1e-9 and difference["low"] <= welch["low"] + 1e-9
     table = (out / "comparison.md").read_text()
     assert "| resnet18+boxes |" in table and "| seannet-graph |" in table
+
+
+def test_a_resumed_comparison_trains_the_batches_its_calibration_kept(
+    tmp_path: Path, mini_dataset: Path
+) -> None:
+    # stopped before its selection was written and started again (maybe on another machine):
+    # the calibration kept in calibrations.json sets the batches, not a second timing
+    out = tmp_path / "cmp"
+    ask = {"preset": TINY, "seeds": (0,), "lrs": (0.01,), "budget_s": 0.001}
+    first = compare_models(mini_dataset, out, ["resnet18"], **ask)["models"][0]
+    kept = json.loads((out / CALIBRATIONS).read_text())
+    assert [r["key"]["trained"] for r in kept] == ["resnet18"]
+    assert {**kept[0]["calibration"], "source": "calibrated"} == first["budget"]
+    (out / SELECTION).unlink()
+    again = compare_models(mini_dataset, out, ["resnet18"], **ask)["models"][0]
+    assert again["budget"] == first["budget"]  # the same timing, not a new one
+    assert json.loads((out / CALIBRATIONS).read_text()) == kept
+    # the kept record is what sets the batches: one that says 2 trains 2 a epoch
+    other = tmp_path / "other"
+    other.mkdir()
+    record = json.loads(json.dumps(kept[0]))
+    record["calibration"] |= {"batches": 2, "examples": 2 * TINY.batch_size * TINY.epochs}
+    (other / CALIBRATIONS).write_text(json.dumps([record]))
+    two = compare_models(mini_dataset, other, ["resnet18"], **ask)["models"][0]
+    assert two["batches_per_epoch"] == two["budget"]["batches"] == 2
+    trained = torch.load(Path(two["runs"][0]["run"]) / "last.pt", weights_only=False)
+    assert trained["config"]["max_train_batches"] == 2
+    # another budget is a calibration of its own, kept beside the first
+    compare_models(mini_dataset, out, ["resnet18"], **{**ask, "budget_s": 0.002})
+    assert [r["key"]["budget_s"] for r in json.loads((out / CALIBRATIONS).read_text())] == [
+        0.001,
+        0.002,
+    ]
 
 
 def test_model_specs_name_network_and_imagenet_init() -> None:
