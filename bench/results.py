@@ -269,10 +269,18 @@ def _budget_cell(entry: dict[str, Any], calibrations: dict[str, tuple[str, dict]
             return "recorded (no calibration of it among these runs)"
         own = (f"in `{own[0]}`", own[1])
     where, b = own
-    return (
+    said = (
         f"calibrated {where}: {b['budget_s']:g} s, a step {b['step_s']:.3f} s, rounds "
         f"{100 * b['spread']:.0f} % apart"
     )
+    by = b.get("converted_by")
+    if by:  # timed on a later machine, in the first one's seconds
+        said += (
+            f" (timed {by['timed_s']:.3f} s on a later machine, put in the first one's seconds "
+            f"by {by['reference']}'s step: {by['reference_then_s']:.3f} s there, "
+            f"{by['reference_now_s']:.3f} s here)"
+        )
+    return said
 
 
 def _rule(entry: dict[str, Any], calibrations: dict[str, tuple[str, dict]]) -> tuple | None:

@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -57,7 +58,7 @@ from seannet.evaluation.intervals import (
 )
 from seannet.evaluation.run_eval import evaluate_run
 from seannet.model.specs import parse_spec
-from seannet.provenance import provenance_record
+from seannet.provenance import PROCESS, provenance_record
 from seannet.training.budget import Calibration, calibrate
 from seannet.training.config import TrainConfig
 from seannet.training.config import preset as load_preset
@@ -160,7 +161,7 @@ def compare_models(
         if budget_s is not None or spec.trained in batches:
             if spec.trained not in batches:
                 calibrations[spec.trained] = _calibration(
-                    spec.trained, config, ds, out, budget_s, say
+                    spec.trained, config, base, ds, out, budget_s, say
                 )
                 batches[spec.trained] = calibrations[spec.trained].batches
             config = config.replace(max_train_batches=batches[spec.trained])
@@ -240,6 +241,7 @@ def _select(
 def _calibration(
     trained: str,
     config: TrainConfig,
+    base: TrainConfig,
     ds: Dataset,
     out: Path,
     budget_s: float,
@@ -250,17 +252,21 @@ def _calibration(
     The first one taken is kept in ``out/calibrations.json`` (before any run trains) and
     reused by every later call with the same network, budget and step shape: a comparison
     resumed, maybe on another machine, must train the batches its runs began with, and a
-    second timing differs (by a few per cent on one machine, by half on another)."""
+    second timing differs (by a few per cent on one machine, by half on another). A network
+    first timed by a later process, while the file holds networks timed by an earlier one
+    (maybe on another machine), is converted to the earlier one's seconds: the first network
+    of the file is timed again here, and the ratio of its two steps scales the new one's
+    (:meth:`Calibration.converted`), so every network under ``out`` trains by one rule."""
     path = out / CALIBRATIONS
     records = json.loads(path.read_text()) if path.exists() else []
-    key = {
-        "trained": trained,
+    shape = {
         "budget_s": float(budget_s),
         "batch_size": config.batch_size,
         "epochs": config.epochs,
         "image_size": config.model.image_size,
         "device": device_for_run().type,
     }
+    key = {"trained": trained, **shape}
     for record in records:
         if record["key"] == key:
             got = Calibration.from_dict(record["calibration"])
@@ -270,6 +276,17 @@ def _calibration(
             )
             return got
     got = _calibrate(trained, config, ds, budget_s, say)
+    first = next((r for r in records if {**r["key"], "trained": trained} == key), None)
+    here = (os.getpid(), PROCESS.loaded)
+    if first is not None and (first["taken"]["pid"], first["taken"]["code_loaded"]) != here:
+        reference = first["key"]["trained"]
+        now = calibrate(model_spec(reference, base).config, ds, budget_s).step_s
+        got = got.converted(reference, first["calibration"]["step_s"], now, config)
+        say(
+            f"{trained}: {got.batches} batches per epoch in the seconds of {reference}'s "
+            f"calibration at {first['taken']['started']} ({reference}'s step there "
+            f"{got.converted_by['reference_then_s']:.3f} s, here {now:.3f} s)"
+        )
     taken = provenance_record(None, step="calibrate")  # when, by which code and command
     records.append({"key": key, "taken": taken, "calibration": got.to_dict()})
     out.mkdir(parents=True, exist_ok=True)

@@ -22,7 +22,8 @@ number bought when the calibration divided process time by torch's threads: 300 
 thread bought seannet-fc512 7 batches per epoch on the docs' machine of 2026-12-02 (a step
 7.5 s), where the old 150 had recorded 35. Seconds are the machine's own: on the machine of
 2026-12-03 a step took 3.1 s and 300 s bought 19 batches, so runs on two machines are
-compared by their recorded batches, not by their budgets.
+compared by their recorded batches, not by their budgets (``seannet compare`` puts a network
+timed on a later machine in the first machine's seconds: :meth:`Calibration.converted`).
 
 The calibration is a measurement, so two on the same machine may differ by a few per cent:
 what a run got is recorded (:meth:`Calibration.to_dict`, in ``selection.json``) and reused,
@@ -35,7 +36,7 @@ import itertools
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -79,6 +80,9 @@ class Calibration:
     spread: float  # how much slower the slowest round was than the fastest (0.1: 10 %)
     busy: float  # share of the steps' wall time spent on other work (0 on a quiet machine)
     clock: str  # CPU_CLOCK or GPU_CLOCK
+    # when the step was timed on another machine than the runs' first calibration and put in
+    # that machine's seconds (:meth:`converted`): the reference network's step there and here
+    converted_by: dict[str, Any] | None = None
 
     @property
     def noisy(self) -> bool:
@@ -88,6 +92,29 @@ class Calibration:
     def to_dict(self) -> dict[str, Any]:
         """Plain form for ``selection.json``."""
         return {**asdict(self), "steps_s": list(self.steps_s)}
+
+    def converted(
+        self, reference: str, then_s: float, now_s: float, config: TrainConfig
+    ) -> Calibration:
+        """This calibration in the seconds of the machine where ``reference`` (a network the
+        runs' budget was first timed for) took ``then_s`` a step; here it takes ``now_s``.
+        Seconds are the machine's own (a step took 2.9 s on one session's machine and 4.4 s
+        on the next's), so a network timed on a later machine gets the batches the first
+        machine's seconds buy it: what its runs are compared with trained by that rule."""
+        step = self.step_s * then_s / now_s
+        per_epoch = _per_epoch(self.budget_s, config, step)
+        return replace(
+            self,
+            batches=per_epoch,
+            examples=per_epoch * config.batch_size * config.epochs,
+            step_s=step,
+            converted_by={
+                "reference": reference,
+                "reference_then_s": then_s,
+                "reference_now_s": now_s,
+                "timed_s": self.step_s,
+            },
+        )
 
     @classmethod
     def from_dict(cls, record: dict[str, Any]) -> Calibration:
@@ -168,7 +195,7 @@ def calibrate(
     # each batch's fastest round: the same work, least disturbed by the machine's other work
     cost = float(steps[:, :, 0].min(axis=0).mean())
     per_round = steps[:, :, 0].mean(axis=1)
-    per_epoch = max(1, int(budget_s / config.epochs / cost))
+    per_epoch = _per_epoch(budget_s, config, cost)
     return Calibration(
         budget_s=float(budget_s),
         batches=per_epoch,
@@ -179,6 +206,11 @@ def calibrate(
         busy=0.0 if gpu else float(max(0.0, 1.0 - steps[..., 0].sum() / steps[..., 1].sum())),
         clock=GPU_CLOCK if gpu else CPU_CLOCK,
     )
+
+
+def _per_epoch(budget_s: float, config: TrainConfig, step_s: float) -> int:
+    """Batches per epoch whose steps fill ``budget_s`` over the run's epochs (at least one)."""
+    return max(1, int(budget_s / config.epochs / step_s))
 
 
 def calibrate_batches(config: TrainConfig, data: DataSource, budget_s: float) -> int:

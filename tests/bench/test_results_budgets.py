@@ -97,3 +97,23 @@ def test_sections_compare_like_for_like(
     assert section.count("| not recorded |") == len(old["models"])
     assert f"Like for like not shown: {ours}, seannet-image have no budget record" in section
     assert "Like for like: every" not in section
+
+
+def test_a_network_timed_on_a_later_machine_says_so() -> None:
+    results = load_bench("results")
+    budget = {"source": "calibrated", "budget_s": 1200.0, "step_s": 3.1, "spread": 0.05}
+    entry = {"trained": "seannet", "batches_per_epoch": 77, "budget": budget}
+    assert results._budget_cell(entry, {}) == (
+        "calibrated here: 1200 s, a step 3.100 s, rounds 5 % apart"
+    )
+    converted = {
+        "reference": "resnet18",
+        "reference_then_s": 2.0,
+        "reference_now_s": 4.0,
+        "timed_s": 6.2,
+    }
+    entry["budget"] = {**budget, "converted_by": converted}
+    assert results._budget_cell(entry, {}).endswith(
+        "(timed 6.200 s on a later machine, put in the first one's seconds by resnet18's "
+        "step: 2.000 s there, 4.000 s here)"
+    )

@@ -138,6 +138,36 @@ def test_a_resumed_comparison_trains_the_batches_its_calibration_kept(
     ]
 
 
+def test_a_network_timed_on_a_later_machine_gets_the_first_machines_seconds(
+    tmp_path: Path, mini_dataset: Path
+) -> None:
+    # the runs' first calibration was taken by another process on a machine where resnet18
+    # took 100 s a step (far slower than here): seannet-graph, first timed now, is put in that
+    # machine's seconds by resnet18's step there and here, not given this machine's
+    out = tmp_path / "cmp"
+    out.mkdir()
+    shape = {"budget_s": 1000.0, "batch_size": 4, "epochs": 1, "image_size": 64, "device": "cpu"}
+    then = {"budget_s": 1000.0, "batches": 1, "examples": 4, "step_s": 100.0, "steps_s": [100.0]}
+    record = {
+        "key": {"trained": "resnet18", **shape},
+        "taken": {"pid": -1, "code_loaded": "2026-12-01 00:00:00 UTC", "started": "then"},
+        "calibration": then | {"spread": 0.0, "busy": 0.0, "clock": "thread-cpu, 1 torch thread"},
+    }
+    (out / CALIBRATIONS).write_text(json.dumps([record]))
+    ask = {"preset": TINY, "seeds": (0,), "lrs": (0.01,), "budget_s": 1000.0}
+    models = compare_models(mini_dataset, out, ["resnet18", "seannet-graph"], **ask)["models"]
+    assert models[0]["budget"]["step_s"] == 100.0 and models[0]["batches_per_epoch"] == 1
+    graph = models[1]["budget"]
+    by = graph["converted_by"]
+    assert by["reference"] == "resnet18" and by["reference_then_s"] == 100.0
+    assert 0 < by["reference_now_s"] < 10 and 0 < by["timed_s"] < 10  # timed here, far faster
+    assert graph["step_s"] == pytest.approx(by["timed_s"] * 100.0 / by["reference_now_s"])
+    assert graph["batches"] == models[1]["batches_per_epoch"] == max(1, int(1000 / graph["step_s"]))
+    kept = json.loads((out / CALIBRATIONS).read_text())
+    assert [r["key"]["trained"] for r in kept] == ["resnet18", "seannet-graph"]
+    assert {**kept[1]["calibration"], "source": "calibrated"} == graph
+
+
 def test_model_specs_name_network_and_imagenet_init() -> None:
     spec = model_spec("seannet@lite0+imagenet", TINY)
     assert (spec.config.model.name, spec.config.model.backbone, spec.pretrained) == (
