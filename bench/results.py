@@ -238,12 +238,14 @@ def _span(entry: dict[str, float], sign: bool = False) -> str:
     return f"{f(entry['mean'])} [{f(entry['low'])}, {f(entry['high'])}]"
 
 
-def _budget(result: dict[str, Any]) -> str:
-    """What the comparison's budget meant, from its records."""
+def _budget(runs: Path, result: dict[str, Any]) -> str:
+    """What the comparison's budget meant, from its records (a step that reused an earlier
+    step's batches is read through that step's calibration)."""
     seconds = result["budget_s"]
     if seconds is None:
         return "the preset's batches per epoch for every model"
-    if any("clock" in (e.get("budget") or {}) for e in result["models"]):
+    calibrations = _calibrations(runs, seconds)
+    if any(_rule(e, calibrations) not in (None, ("preset",)) for e in result["models"]):
         return (
             f"{seconds:g} s of one thread's compute per run (each network's batches per epoch "
             "from its timed steps; what each got: below)"
@@ -386,7 +388,7 @@ def _stamp(runs: Path, step: str) -> list[str]:
 
 def _comparison_tables(runs: Path, result: dict[str, Any]) -> list[str]:
     lines = [
-        f"Preset `{result['preset']}`, {_budget(result)}, learning rate of each "
+        f"Preset `{result['preset']}`, {_budget(runs, result)}, learning rate of each "
         "model chosen on "
         f"the whole val split from {result['lrs']} with seed {result['seeds'][0]}, then seeds "
         f"{result['seeds']} at it; test read once, after `selection.json` was written.",

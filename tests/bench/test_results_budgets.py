@@ -64,6 +64,9 @@ def test_sections_compare_like_for_like(
     section = _section(doc, "SeanNet plus the hand-made overlap")
     headline_runs = f"the headline {ours}'s runs"
     assert f"{ours}+boxes: {headline_runs}; {ours}: {headline_runs}" in section
+    # its batches are the headline's, timed by today's rule: the section says that rule
+    assert f"{BUDGET_S:g} s of one thread's compute per run" in section
+    assert "timed before 2026-12-02" not in section
     section = _section(doc, "Ablations")
     for name, entry in ablations.items():
         row = (
