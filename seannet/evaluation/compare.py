@@ -258,7 +258,7 @@ def _calibration(
     of the file is timed again here, and the ratio of its two steps scales the new one's
     (:meth:`Calibration.converted`), so every network under ``out`` trains by one rule."""
     path = out / CALIBRATIONS
-    records = json.loads(path.read_text()) if path.exists() else []
+    records = _read_calibrations(path)
     shape = {
         "budget_s": float(budget_s),
         "batch_size": config.batch_size,
@@ -292,6 +292,26 @@ def _calibration(
     out.mkdir(parents=True, exist_ok=True)
     atomic_write_text(path, json.dumps(records, indent=2))
     return got
+
+
+def _read_calibrations(path: Path) -> list[dict[str, Any]]:
+    """The records of ``path`` (none when it is absent).
+
+    Raises:
+        ModelError: the file is not a list of calibration records.
+    """
+    if not path.exists():
+        return []
+    try:
+        records = json.loads(path.read_text())
+        if all({"key", "taken", "calibration"} <= set(r) for r in records):
+            return records
+    except (ValueError, TypeError):
+        pass
+    raise ModelError(
+        f"{path}: not a list of calibration records (key, taken, calibration); restore it, or "
+        "delete it to time the networks again (runs already trained then refuse to resume)"
+    )
 
 
 def _calibrate(

@@ -168,6 +168,18 @@ def test_a_network_timed_on_a_later_machine_gets_the_first_machines_seconds(
     assert {**kept[1]["calibration"], "source": "calibrated"} == graph
 
 
+@pytest.mark.parametrize("text", ["{not json", "[1, 2]", '[{"key": {}}]'])
+def test_a_damaged_calibrations_file_is_one_clear_error(
+    tmp_path: Path, mini_dataset: Path, text: str
+) -> None:
+    out = tmp_path / "cmp"
+    out.mkdir()
+    (out / CALIBRATIONS).write_text(text)
+    with pytest.raises(ModelError, match=r"calibrations.json: not a list of calibration"):
+        compare_models(mini_dataset, out, ["resnet18"], preset=TINY, budget_s=0.001)
+    assert not (out / "resnet18").exists()  # refused before any run trained
+
+
 def test_model_specs_name_network_and_imagenet_init() -> None:
     spec = model_spec("seannet@lite0+imagenet", TINY)
     assert (spec.config.model.name, spec.config.model.backbone, spec.pretrained) == (
