@@ -266,7 +266,8 @@ def _missing(points: dict[str, list[dict[str, Any]]]) -> list[str]:
         for budget, seeds in BUDGETS:
             got = have.get(budget, 0)
             if got < seeds:
-                out.append(f"{model} at {budget:g} s: {seeds} seed(s) asked, {got} run")
+                asked = "1 seed" if seeds == 1 else f"{seeds} seeds"
+                out.append(f"{model} at {budget:g} s: {asked} asked, {got} run")
     return out
 
 

@@ -466,7 +466,8 @@ def _noise_loss(runs: Path, result: dict[str, Any], model: str) -> str:
     losses = _aim_losses(runs, result, model)
     if not losses:
         return "not measured"
-    return f"{100 * sum(losses) / len(losses):.1f} points ({len(losses)} seeds)"
+    seeds = "1 seed" if len(losses) == 1 else f"{len(losses)} seeds"
+    return f"{100 * sum(losses) / len(losses):.1f} points ({seeds})"
 
 
 def _noise_met(runs: Path, result: dict[str, Any], model: str) -> str:
@@ -523,7 +524,8 @@ def _full_map_aim(runs: Path) -> str:
         return "| full-map recall@1 >= 90 % | not measured (below) | - |"
     recall = sum(r["recall@1"] for r in seannet) / len(seannet)
     return (
-        f"| full-map recall@1 >= 90 % | {_pct(recall)} % ({len(seannet)} seed) | "
+        f"| full-map recall@1 >= 90 % | {_pct(recall)} % "
+        f"({len(seannet)} seed{'' if len(seannet) == 1 else 's'}) | "
         f"{'yes' if recall >= 0.9 else 'no'} |"
     )
 
@@ -779,23 +781,40 @@ LATER_STEPS = {
 }
 
 
-def _step_ran(runs: Path, step: str, head: dict[str, Any]) -> bool:
+def _step_progress(runs: Path, step: str, head: dict[str, Any]) -> tuple[int, int]:
+    """(done, asked) of ``step``'s measurements under ``runs``: its evaluations (noise), its
+    maps (fullmap), or its one comparison."""
     if step == "noise":
-        shown = {e["model"] for e in head["models"]}
-        return any(_aim_losses(runs, head, m) for m in NOISE_MODELS if m in shown)
+        chosen = {e["model"]: e["runs"] for e in head["models"]}
+        asked = [
+            (model, point, Path(r["run"]))
+            for model in NOISE_MODELS
+            if model in chosen
+            for point in NOISE_GRID
+            for r in (chosen[model] if point == AIM else chosen[model][:1])
+        ]
+        done = sum(
+            eval_file(run, "test", boxes=scene_term(m), noise=BoxNoise(jitter=s, drop=p)).exists()
+            for m, (s, p), run in asked
+        )
+        return done, len(asked)
     if step == "fullmap":
-        return bool(_full_map_results(runs))
-    return (runs / f"comparison-{step}.json").exists()
+        found = _full_map_results(runs)
+        return sum(model in found for model in FULL_MAP_MODELS), len(FULL_MAP_MODELS)
+    return int((runs / f"comparison-{step}.json").exists()), 1
 
 
 def _steps_not_run(runs: Path, head: dict[str, Any]) -> list[str]:
-    """A line per step of :data:`LATER_STEPS` without results under ``runs`` (read from the
-    files, so a set run in parts says what it still lacks)."""
-    return [
-        f"- {what}: `python bench/results.py run DATA RUNS --steps {step}`; not run for this set."
-        for step, what in LATER_STEPS.items()
-        if not _step_ran(runs, step, head)
-    ]
+    """A line per step of :data:`LATER_STEPS` without all its results under ``runs`` (read
+    from the files, so a set run in parts says what it still lacks)."""
+    lines = []
+    for step, what in LATER_STEPS.items():
+        done, asked = _step_progress(runs, step, head)
+        if done == asked:
+            continue
+        said = "not run for this set" if not done else f"{done} of {asked} measured"
+        lines.append(f"- {what}: `python bench/results.py run DATA RUNS --steps {step}`; {said}.")
+    return lines
 
 
 def _not_on_gpu(runs: Path) -> list[str]:

@@ -168,7 +168,8 @@ def read_provenance(
 
 
 def stamp(records: Sequence[dict[str, Any]]) -> str:
-    """A markdown line naming every run of ``records``: commit (and whether it had
+    """A markdown line naming every command of ``records`` (a process's call, which may
+    train many runs): commit (and whether it had
     uncommitted changes), start, data fingerprint, command. Empty when there is none."""
     if not records:
         return ""
@@ -186,5 +187,5 @@ def stamp(records: Sequence[dict[str, Any]]) -> str:
         parts.append(
             f"commit `{r['commit'][:10]}`{dirty}, started {r['started']}{data}: `{r['command']}`"
         )
-    runs = "run" if len(parts) == 1 else f"{len(parts)} runs"
-    return f"*Made by {runs}: " + "; ".join(parts) + ".*"
+    calls = "one command" if len(parts) == 1 else f"{len(parts)} commands"
+    return f"*Made by {calls}: " + "; ".join(parts) + ".*"

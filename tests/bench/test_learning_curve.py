@@ -43,7 +43,7 @@ def test_curve_scales_the_first_budget_and_writes_the_runs(
     assert f"{100 * last['test']['mean']:.1f} (1 seed)" in text
     assert f"| {first['lr']:g} (val, of 0.003 / 0.01) |" in text
     # the default design's models were not run here: the page lists each point it lacks
-    assert "- seannet-fc512 at 4800 s: 1 seed(s) asked, 0 run" in text
+    assert "- seannet-fc512 at 4800 s: 1 seed asked, 0 run" in text
     assert f"{100 * first['val']['mean']:.1f} ± {100 * first['val']['ci95']:.1f}" in text
 
 

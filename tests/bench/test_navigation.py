@@ -50,7 +50,7 @@ def test_tables_from_tiny_runs(
     assert "typed by hand" not in text and "prose that stays" in text
     assert "| paper, SeanNet | 5,476 / 204,136 | 80.2 / 65.2 | 2.4 / 6.2 | 13.2 / 21.7 |" in text
     assert made["commit"][:10] in text and made["manifest_sha256"][:16] in text
-    assert "Made by 2 runs" in text and text.count(first["started"]) >= 1
+    assert "Made by 2 commands" in text and text.count(first["started"]) >= 1
     results = navigation_run.results
     (run,) = results["runs"]
     label = f"| {run['model']} ({run['label']}) | 2 / 2 |"

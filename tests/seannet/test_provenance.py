@@ -39,7 +39,8 @@ def test_records_are_appended_and_each_is_named(tmp_path: Path) -> None:
     assert first["commit"] == PROCESS.commit and first["format_version"] == "2.0.1"
     assert first["dataset_seed"] == 7 and len(first["manifest_sha256"]) == 64
     text = stamp(read_provenance(run))
-    assert text.startswith("*Made by 2 runs:") and text.count(first["manifest_sha256"][:16]) == 2
+    assert text.startswith("*Made by 2 commands:")
+    assert text.count(first["manifest_sha256"][:16]) == 2
     # a killed writer's torn last line is skipped
     with open(run / PROVENANCE, "a") as f:
         f.write('{"step": "tr')
