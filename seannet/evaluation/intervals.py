@@ -97,7 +97,12 @@ def _components(
     mean: float, room_var: float, seed_var: float, seeds: int
 ) -> dict[str, float | int]:
     """``mean`` ± a 95 % interval of the summed variance components, t on ``seeds`` - 1
-    degrees of freedom (a normal quantile when one seed leaves none)."""
+    degrees of freedom (a normal quantile when one seed leaves none).
+
+    t on the seeds' dof for the room part too is conservative on purpose: Welch-Satterthwaite
+    would raise the dof when rooms dominate, and then the interval can come out narrower than
+    the seeds' own t-interval (room variance half the seeds' over 3 seeds: 0.76 of its width),
+    which the protocol forbids (DESIGN §12)."""
     quantile = float(stats.t.ppf(0.975, seeds - 1)) if seeds > 1 else float(stats.norm.ppf(0.975))
     half = quantile * math.sqrt(room_var + seed_var)
     return {
