@@ -1,6 +1,6 @@
 """docs/benchmarks.md as code: run the benchmark scripts, keep what each printed, write the page.
 
-    .venv/bin/python bench/suite.py run OUT                 # the suite, then the page (~10 min)
+    .venv/bin/python bench/suite.py run OUT                 # the suite, then the page (~15 min)
     .venv/bin/python bench/suite.py run OUT --rooms 24 --views 30 --validate out/results \\
         --extras channels,assets,fuzz                       # and the scripts the suite skips
     .venv/bin/python bench/suite.py page OUT                # the page again from OUT
@@ -24,6 +24,8 @@ Measures:
   and with Ray (a local instance, 2 workers);
 - loader: ``bench/loader.py`` on a ``tiny`` dataset generated for the run;
 - validate: ``sgdata validate`` on a dataset (``--validate``, default that ``tiny`` one);
+- train: ``bench/train_step.py`` on that ``tiny`` one: each network docs/results.md trains,
+  its step timed by the training budget's own rule and the batches ``1200`` s buy it;
 - extras (``--extras``): ``bench/channels.py``, ``bench/assets.py``, ``bench/fuzz.py``.
 """
 
@@ -55,7 +57,7 @@ PY = sys.executable
 PAGE = ROOT / "docs" / "benchmarks.md"
 # the hand-assembled page this generator replaced: its figures, each naming its commit
 OLDER = ROOT / "docs" / "benchmarks-2026-12-02.md"
-CORE = ("render", "generate", "loader", "validate")
+CORE = ("render", "generate", "loader", "validate", "train")
 EXTRAS = ("channels", "assets", "fuzz")
 # the ratios the project holds itself to (issue 25): aims, not measurements
 AIMS = {
@@ -223,6 +225,33 @@ def _assets_section(r: dict[str, Any]) -> list[str]:
     return [*_table(("ratio", "figure"), ratios), "", *_table(("figure", "value"), rows)]
 
 
+def _train_commands(args: argparse.Namespace, tiny: Path) -> list[list[str]]:
+    return [[PY, str(BENCH / "train_step.py"), str(tiny), "--json"]]
+
+
+def _train_section(r: dict[str, Any]) -> list[str]:
+    first = r["networks"][0]["network"]
+    rows = [
+        (
+            f"`{n['network']}`",
+            f"{n['step_s']:.3f}",
+            f"{n['step_ratio']:.2f}x",
+            f"{100 * n['spread']:.0f} %",
+            f"{100 * n['busy']:.0f} %",
+            str(n["batches"]),
+        )
+        for n in r["networks"]
+    ]
+    return [
+        f"A step of {r['batch_size']} triplets of the `cpu` preset, timed the way a run's "
+        f"budget is ({r['clock']}; `seannet.training.budget.calibrate`): the networks "
+        f"docs/results.md trains, and the batches per epoch {r['budget_s']:g} s buy each over "
+        f"{r['epochs']} epochs. A budget buys batches in inverse proportion to these steps.",
+        "",
+        *_table(("network", "step s", f"x {first}", "spread", "busy", "batches per epoch"), rows),
+    ]
+
+
 def _fuzz_commands(args: argparse.Namespace, tiny: Path) -> list[list[str]]:
     return [[PY, str(BENCH / "fuzz.py"), "--examples", "200", "--json"]]
 
@@ -278,6 +307,12 @@ MEASURES: dict[str, Measure] = {
             "seconds": round(seconds, 2),
         },
         _validate_section,
+    ),
+    "train": Measure(
+        "A training step, by the budget's rule (`bench/train_step.py`)",
+        _train_commands,
+        lambda outs, _s, _c: _last_json(outs[0]),
+        _train_section,
     ),
     "channels": Measure(
         "Channels: depth and instance masks (`bench/channels.py`)",

@@ -1,31 +1,37 @@
-"""What one training step costs: SeanNet against its image baseline, and the GCN's two forms.
+"""What one training step costs each network, timed by the training budget's own rule.
 
-    python bench/train_step.py DATA [--preset cpu] [--steps 6]
-    python bench/train_step.py DATA --profile [--steps 3]   # where SeanNet's step goes
-    python bench/train_step.py DATA --graph-hidden 1024 512 # SeanNet with a narrower GCN fc
+    python bench/train_step.py DATA [--models resnet18,seannet] [--budget 1200] [--json]
+    python bench/train_step.py DATA --gcn-forms [--steps 6]  # SeanNet's GCN: dense vs nodes
+    python bench/train_step.py DATA --profile [--steps 3]    # where SeanNet's step goes
 
-Times, on real triplet batches of DATA's train split (image cache on), a whole training step
-(three embeddings, triplet loss, backward, SGD) of ``seannet`` and ``resnet18``, then the
-scene-graph branch alone (forward + backward on the batch's object features): the paper's
-dense form over B x M slots (``MultiPathwayGCN.forward``) against the present nodes only
-(``forward_nodes``, what SeanNet runs). Run it on a quiet machine; figures in
-docs/benchmarks.md.
+By default, every network that docs/results.md trains (``bench/results.py``'s headline, fc and
+ablation networks; ``--models`` names others) is timed by
+:func:`seannet.training.budget.calibrate`, the function that sets a run's batches: torch on one
+thread, the thread's own CPU clock, each batch's fastest of two rounds, on real triplet batches
+of DATA's train split. Each network's step, the rounds' spread, the share of wall time that
+went to other work, the batches per epoch ``--budget`` seconds buy it, and its step against
+the first network's: the same figures a comparison's budget table prints, so the two cannot
+disagree (a wall-clock timing on all threads once said seannet-fc512's step was 1.19x
+ResNet-18's where the calibration gave 1.8x).
 
-``--profile`` instead times SeanNet's step part by part (:func:`profile_step`): forward and
-backward of each top-level part of the model (image trunk, head, object features and fcn, the
-GCN pathways, the GCN's fc, fusion, layout pathway), the loss and the optimiser, with each
-part's parameter count. ``--batch-size`` overrides the preset's batch (a quick look).
-``--graph-hidden`` adds, after the two, SeanNet's step with each of these hidden widths of the
-GCN's fc (``ModelConfig.graph_hidden``; 4,096 is the paper's), each against ResNet-18's.
+``--gcn-forms`` times SeanNet's step on the wall clock (torch's threads), then its scene-graph
+branch alone (forward + backward on the batch's object features): the paper's dense form over
+B x M slots (``MultiPathwayGCN.forward``) against the present nodes only (``forward_nodes``,
+what SeanNet runs). ``--profile`` instead times SeanNet's step part by part
+(:func:`profile_step`): forward and backward of each top-level part of the model (image trunk,
+head, object features and fcn, the GCN pathways, the GCN's fc, fusion, layout pathway), the
+loss and the optimiser, with each part's parameter count. ``--batch-size`` overrides the
+preset's batch (a quick look). Run it on a quiet machine.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 import time
 from collections import defaultdict
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import ExitStack, contextmanager
 from pathlib import Path
 from typing import Any
@@ -33,15 +39,26 @@ from typing import Any
 import torch
 from torch.utils.data import DataLoader
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+BENCH = Path(__file__).resolve().parent
+sys.path.insert(0, str(BENCH.parent))
+sys.path.append(str(BENCH))  # for results.py; last, so no bench script shadows a package
+
+from results import ABLATIONS, FC, HEADLINE  # noqa: E402
 
 from seannet.data.datasets import ImageTransform, TripletDataset, collate_triplets  # noqa: E402
+from seannet.evaluation.compare import model_spec  # noqa: E402
 from seannet.model.loss import TripletLoss  # noqa: E402
 from seannet.model.seannet import SeanNet  # noqa: E402
-from seannet.training.config import preset  # noqa: E402
+from seannet.model.specs import parse_spec  # noqa: E402
+from seannet.training.budget import CPU_CLOCK, GPU_CLOCK, calibrate  # noqa: E402
+from seannet.training.config import TrainConfig, preset  # noqa: E402
 from seannet.training.loop import train_one_epoch, triplet_step  # noqa: E402
-from seannet.training.runs import build_for_dataset  # noqa: E402
+from seannet.training.runs import build_for_dataset, device_for_run  # noqa: E402
+
+# the networks docs/results.md trains (a scene term adds no training step), ResNet-18 first
+RESULTS_NETWORKS = tuple(
+    dict.fromkeys(parse_spec(spec).trained for spec in ("resnet18", *HEADLINE, *FC, *ABLATIONS))
+)
 
 
 def seconds_per_call(fn, calls: int) -> float:
@@ -56,54 +73,101 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("data", type=Path)
     parser.add_argument("--preset", default="cpu")
-    parser.add_argument("--steps", type=int, default=6)
+    parser.add_argument(
+        "--models",
+        type=lambda text: text.split(","),
+        default=list(RESULTS_NETWORKS),
+        help="comma-separated networks, the first the others are measured against",
+    )
+    parser.add_argument("--budget", type=float, default=1200.0, help="seconds of one thread")
+    parser.add_argument("--json", action="store_true", help="the figures as one JSON line")
+    parser.add_argument("--steps", type=int, default=6, help="--gcn-forms, --profile: steps")
+    parser.add_argument("--gcn-forms", action="store_true", help="SeanNet's GCN, dense vs nodes")
     parser.add_argument("--profile", action="store_true", help="SeanNet's step, part by part")
     parser.add_argument("--batch-size", type=int, help="triplets a batch (default: the preset's)")
-    parser.add_argument(
-        "--graph-hidden", type=int, nargs="*", default=[], help="SeanNet's GCN fc widths to add"
-    )
     args = parser.parse_args()
     torch.manual_seed(0)
+    base = preset(args.preset)
+    if args.batch_size:
+        base = base.replace(batch_size=args.batch_size)
     if args.profile:
-        config = preset(args.preset).replace(model="seannet")
-        if args.batch_size:
-            config = config.replace(batch_size=args.batch_size)
-        print(profile_report(profile_step(config, args.data, args.steps), config))
-        return
-    figures = {}
-    variants = [("resnet18", {}), ("seannet", {})]
-    variants += [(f"seannet, graph_hidden {w}", {"graph_hidden": w}) for w in args.graph_hidden]
-    for label, changes in variants:
-        name = label.split(",")[0]
-        config = preset(args.preset).replace(model=name, **changes)
-        if args.batch_size:
-            config = config.replace(batch_size=args.batch_size)
-        model = build_for_dataset(config, args.data).train()
-        transform = ImageTransform.for_model(config.model.image_size, config.model.image_family)
-        triplets = TripletDataset(args.data, "train", transform=transform, cache=True)
-        loader = DataLoader(triplets, batch_size=config.batch_size, collate_fn=collate_triplets)
-        batches = [next(iter(loader))]
-        optimiser = torch.optim.SGD(model.parameters(), lr=config.lr, momentum=config.momentum)
-        loss_fn = TripletLoss(margin=config.margin)
-        triplets_step = triplet_step(model, loss_fn, torch.device("cpu"))
+        seannet = base.replace(model="seannet")
+        print(profile_report(profile_step(seannet, args.data, args.steps), seannet))
+    elif args.gcn_forms:
+        gcn_forms(base.replace(model="seannet"), args.data, args.steps)
+    else:
+        figures = step_costs(args.data, args.models, base, args.budget)
+        print(json.dumps(figures) if args.json else step_report(figures))
 
-        def step(model=model, batches=batches, optimiser=optimiser, step=triplets_step) -> None:
-            train_one_epoch(model, batches, step, optimiser)  # the step every run trains by
 
-        figures[label] = seconds_per_call(step, args.steps)
-        print(f"{label} training step, batch {config.batch_size}: {figures[label]:.3f} s")
-        if changes:
-            ratio = figures[label] / figures["resnet18"]
-            print(f"  {label} / resnet18 step: {ratio:.2f}x")
-        elif isinstance(model, SeanNet):
-            graph_forms(model, batches[0][0], args.steps)
-            with dense_gcn(model):
-                dense_step = seconds_per_call(step, args.steps)
-            print(
-                f"  the same step with the dense GCN: {dense_step:.3f} s "
-                f"({dense_step / figures[label]:.2f}x the present-nodes step)"
-            )
-            print(f"seannet / resnet18 step: {figures['seannet'] / figures['resnet18']:.2f}x")
+def step_costs(
+    data: Path, models: Sequence[str], base: TrainConfig, budget_s: float
+) -> dict[str, Any]:
+    """Each network's step as the budget times it, and what ``budget_s`` buys it."""
+    rows = []
+    for spec in models:
+        got = calibrate(model_spec(spec, base).config, data, budget_s)
+        rows.append(
+            {
+                "network": spec,
+                "step_s": got.step_s,
+                "spread": got.spread,
+                "busy": got.busy,
+                "batches": got.batches,
+                "examples": got.examples,
+            }
+        )
+    for row in rows:
+        row["step_ratio"] = row["step_s"] / rows[0]["step_s"]
+    return {
+        "budget_s": budget_s,
+        "batch_size": base.batch_size,
+        "epochs": base.epochs,
+        "clock": CPU_CLOCK if device_for_run().type == "cpu" else GPU_CLOCK,
+        "networks": rows,
+    }
+
+
+def step_report(figures: dict[str, Any]) -> str:
+    """:func:`step_costs` as a markdown table."""
+    first = figures["networks"][0]["network"]
+    lines = [
+        f"A training step of {figures['batch_size']} triplets, timed by the budget's rule "
+        f"({figures['clock']}); batches per epoch that {figures['budget_s']:g} s buy over "
+        f"{figures['epochs']} epochs",
+        "",
+        f"| network | step s | x {first} | spread | busy | batches per epoch |",
+        "|---|---|---|---|---|---|",
+    ]
+    lines += [
+        f"| `{r['network']}` | {r['step_s']:.3f} | {r['step_ratio']:.2f}x | "
+        f"{100 * r['spread']:.0f} % | {100 * r['busy']:.0f} % | {r['batches']} |"
+        for r in figures["networks"]
+    ]
+    return "\n".join(lines)
+
+
+def gcn_forms(config: TrainConfig, data: Path, steps: int) -> None:
+    """SeanNet's step on the wall clock, and with the dense GCN; its GCN branch alone."""
+    model = build_for_dataset(config, data).train()
+    transform = ImageTransform.for_model(config.model.image_size, config.model.image_family)
+    triplets = TripletDataset(data, "train", transform=transform, cache=True)
+    loader = DataLoader(triplets, batch_size=config.batch_size, collate_fn=collate_triplets)
+    batches = [next(iter(loader))]
+    optimiser = torch.optim.SGD(model.parameters(), lr=config.lr, momentum=config.momentum)
+    triplets_step = triplet_step(model, TripletLoss(margin=config.margin), torch.device("cpu"))
+
+    def step() -> None:
+        train_one_epoch(model, batches, triplets_step, optimiser)  # the step every run trains by
+
+    nodes_step = seconds_per_call(step, steps)
+    with dense_gcn(model):
+        dense_step = seconds_per_call(step, steps)
+    print(
+        f"seannet training step, batch {config.batch_size}: {nodes_step:.3f} s; with the dense "
+        f"GCN {dense_step:.3f} s ({dense_step / nodes_step:.2f}x the present-nodes step)"
+    )
+    graph_forms(model, batches[0][0], steps)
 
 
 @contextmanager

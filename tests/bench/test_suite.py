@@ -31,6 +31,18 @@ def test_the_page_is_the_scripts_figures(tmp_path: Path, mini_dataset: Path) -> 
     ]
     record = {"measure": "generate", "stamp": stamp, "commands": [["x"]], "result": runs}
     (out / "generate.json").write_text(json.dumps(record))
+    # a train record as bench/train_step.py --json prints it: its rows, as measured
+    steps = {
+        "budget_s": 1200.0, "batch_size": 16, "epochs": 5, "clock": "thread-cpu, 1 torch thread",
+        "networks": [
+            {"network": "resnet18", "step_s": 2.5, "spread": 0.04, "busy": 0.01, "batches": 96,
+             "examples": 7680, "step_ratio": 1.0},
+            {"network": "seannet", "step_s": 4.25, "spread": 0.31, "busy": 0.0, "batches": 56,
+             "examples": 4480, "step_ratio": 1.7},
+        ],
+    }  # fmt: skip
+    train = {"measure": "train", "stamp": stamp, "commands": [["x"]], "result": steps}
+    (out / "train.json").write_text(json.dumps(train))
     older = tmp_path / "older.md"
     older.write_text("# Old\n\n## A section\n\nMeasured at `abc1234`: 3 views/s.\n")
 
@@ -45,6 +57,8 @@ def test_the_page_is_the_scripts_figures(tmp_path: Path, mini_dataset: Path) -> 
     assert f"| PNG bytes per view, image | {result['bytes_per_view']['image']:,} |" in doc
     assert "| **2 workers / 1** | 2.00x | >= 1.8x |" in doc
     assert "| **Ray local / local pool** | 0.88x | >= 0.8x |" in doc
+    assert "| `seannet` | 4.250 | 1.70x | 31 % | 0 % | 56 |" in doc
+    assert "batches per epoch 1200 s buy each over 5 epochs" in doc
     # what was not measured is listed with its command; the older page is fingerprinted
     assert "## Not measured in this set" in doc
     assert "`python bench/suite.py run OUT --extras fuzz`" in doc

@@ -1,7 +1,9 @@
-"""bench/train_step.py --profile: SeanNet's real step on the mini dataset, part by part."""
+"""bench/train_step.py: the networks' steps by the budget's rule, SeanNet's GCN forms and its
+step part by part, on the mini dataset's real batches."""
 
 from __future__ import annotations
 
+import json
 import os
 import re
 import shutil
@@ -55,20 +57,42 @@ def test_profile_books_the_whole_step_to_parts(mini_dataset: Path, tmp_path: Pat
     assert re.search(r"backward booked to a part: (9\d|100)\.\d %", out)
 
 
-def test_the_step_comparison_and_branch_motion_train_by_the_library_step(
+def test_step_costs_are_the_budgets_calibration_and_branch_motion_trains_by_the_library_step(
     mini_dataset: Path, tmp_path: Path
 ) -> None:
-    """bench/train_step.py (without --profile) and bench/branch_motion.py run
+    """bench/train_step.py times each network with the budget's calibration (the figures a
+    comparison's budget table shows), its --gcn-forms and bench/branch_motion.py run
     seannet.training's own step (train_one_epoch over triplet_step) on the mini dataset."""
+    bench = _bench()
+    # by default, the networks bench/results.py trains, once each, ResNet-18 first
+    assert bench.RESULTS_NETWORKS[0] == "resnet18" and "seannet-nolayout" in bench.RESULTS_NETWORKS
+    assert not any("+" in name for name in bench.RESULTS_NETWORKS)
+    assert len(set(bench.RESULTS_NETWORKS)) == len(bench.RESULTS_NETWORKS)
     data = tmp_path / "data"
     shutil.copytree(mini_dataset, data)
     env = {**os.environ, "OMP_NUM_THREADS": "1"}
-    steps = subprocess.run(
-        [sys.executable, str(BENCH / "train_step.py"), str(data), "--batch-size", "2",
-         "--steps", "1"],
-        capture_output=True, text=True, env=env, check=True,
+    command = [sys.executable, str(BENCH / "train_step.py"), str(data), "--batch-size", "2"]
+    figures = json.loads(
+        subprocess.run(
+            [*command, "--models", "resnet18,seannet-fc512", "--budget", "60", "--json"],
+            capture_output=True,
+            text=True,
+            env=env,
+            check=True,
+        ).stdout  # fmt: skip
+    )
+    assert figures["clock"] == "thread-cpu, 1 torch thread" and figures["batch_size"] == 2
+    first, fc512 = figures["networks"]
+    assert (first["network"], fc512["network"]) == ("resnet18", "seannet-fc512")
+    for row in figures["networks"]:  # the budget's rule: batches fill 60 s over the epochs
+        assert row["batches"] == max(1, int(60 / figures["epochs"] / row["step_s"]))
+        assert row["examples"] == row["batches"] * 2 * figures["epochs"]
+        assert row["step_ratio"] == row["step_s"] / first["step_s"]
+    forms = subprocess.run(
+        [*command, "--gcn-forms", "--steps", "1"], capture_output=True, text=True, env=env,
+        check=True,
     ).stdout  # fmt: skip
-    assert "resnet18 training step, batch 2:" in steps and "seannet / resnet18 step:" in steps
+    assert "with the dense GCN" in forms and "present nodes" in forms
     motion = subprocess.run(
         [sys.executable, str(BENCH / "branch_motion.py"), str(data), "--batches", "1"],
         capture_output=True, text=True, env=env, check=True,
