@@ -1,6 +1,7 @@
 """docs/results.md as code: run the measurements of the protocol, then write the tables.
 
     python bench/results.py run DATA RUNS [--steps headline,noise,ablations] [--budget 1200]
+        [--doc docs/results.md]
     python bench/results.py tables DATA RUNS [-o docs/results.md]
 
 ``run`` appends what made the runs (commit at process start, command, dataset manifest sha256
@@ -37,7 +38,8 @@ step and call, and runs each step:
 in it is typed by hand. Each comparison's section says what every model's budget bought
 (batches, triplets, the calibration: ``selection-<step>.json``) and which of its runs are
 the headline's, computed from the run paths. Steps resume: a finished run is not trained
-again.
+again. ``run --doc`` writes the tables after each step and each noise or full-map evaluation
+once the headline exists: the runs live outside git and die with a machine, the doc does not.
 """
 
 from __future__ import annotations
@@ -99,9 +101,18 @@ FULL_MAP = "localize_test.json"  # what `seannet localize --split test` writes p
 def run(args: argparse.Namespace) -> None:
     runs: Path = args.runs
     runs.mkdir(parents=True, exist_ok=True)
+
+    def write_doc() -> None:
+        # what is measured reaches the tree at once: a tracked file survives where a stopped
+        # session loses its gitignored runs (a session's noise, kernel and full-map figures
+        # were lost that way)
+        if args.doc and (runs / "comparison-headline.json").exists():
+            atomic_write_text(args.doc, tables(runs))
+
     for step in args.steps.split(","):
         append_provenance(runs, args.data, step=step)
-        run_step(args.data, runs, step, budget_s=args.budget)
+        run_step(args.data, runs, step, budget_s=args.budget, progress=write_doc)
+        write_doc()
 
 
 def run_step(
@@ -114,9 +125,11 @@ def run_step(
     seeds: Sequence[int] = SEEDS,
     lrs: Sequence[float] = LRS,
     models: Sequence[str] | None = None,
+    progress: Callable[[], None] = lambda: None,
 ) -> None:
     """One step of ``run`` into ``runs`` (``models``: the comparison's, by default the step's
-    own of :data:`COMPARISONS`). A comparison reuses the batches a network was calibrated to
+    own of :data:`COMPARISONS`; ``progress``: called after each evaluation of the noise and
+    full-map steps). A comparison reuses the batches a network was calibrated to
     under the same budget in an earlier step (:func:`_recorded_batches`), and the ``boxes``
     step trains at the headline SeanNet's lr, so its rows are the headline's runs."""
     if step in COMPARISONS:
@@ -135,9 +148,9 @@ def run_step(
             batches=_recorded_batches(runs, budget_s),
         )
     elif step == "noise":
-        noise_step(data, runs)
+        noise_step(data, runs, progress=progress)
     elif step == "fullmap":
-        full_map_step(data, runs)
+        full_map_step(data, runs, progress=progress)
     else:
         raise SystemExit(f"unknown step {step!r}: {', '.join(COMPARISONS)}, noise or fullmap")
 
@@ -184,8 +197,14 @@ def _recorded_batches(runs: Path, budget_s: float | None) -> dict[str, int]:
     return {trained: b["batches"] for trained, (_, b) in _calibrations(runs, budget_s).items()}
 
 
-def noise_step(data: Path, runs: Path, grid: tuple[tuple[float, float], ...] = NOISE_GRID) -> None:
-    """The headline models' runs on test under each (S, P) of ``grid``."""
+def noise_step(
+    data: Path,
+    runs: Path,
+    grid: tuple[tuple[float, float], ...] = NOISE_GRID,
+    progress: Callable[[], None] = lambda: None,
+) -> None:
+    """The headline models' runs on test under each (S, P) of ``grid``; ``progress`` is called
+    after each evaluation."""
     selection = json.loads((runs / "selection-headline.json").read_text())
     chosen = {m["model"]: m["runs"] for m in selection["models"]}
     for model in NOISE_MODELS:
@@ -198,11 +217,15 @@ def noise_step(data: Path, runs: Path, grid: tuple[tuple[float, float], ...] = N
                     continue
                 print(f"{model}: {noise.label()} on {run_dir}", flush=True)
                 evaluate_run(run_dir, data, split="test", boxes=boxes, noise=noise)
+                progress()
 
 
-def full_map_step(data: Path, runs: Path, seeds: int = 1) -> None:
+def full_map_step(
+    data: Path, runs: Path, seeds: int = 1, progress: Callable[[], None] = lambda: None
+) -> None:
     """Full-map recall of the first ``seeds`` chosen runs of each of :data:`FULL_MAP_MODELS`:
-    maps at spacing 1 and the figures (:data:`FULL_MAP`) in ``runs/fullmap/<model>/seed<k>``."""
+    maps at spacing 1 and the figures (:data:`FULL_MAP`) in ``runs/fullmap/<model>/seed<k>``;
+    ``progress`` is called after each run's figures."""
     selection = json.loads((runs / "selection-headline.json").read_text())
     chosen = {m["model"]: m["runs"] for m in selection["models"]}
     rooms = list(open_dataset(data).rooms("test"))
@@ -215,6 +238,7 @@ def full_map_step(data: Path, runs: Path, seeds: int = 1) -> None:
             localizer = load_localizer(run, data, require_epsilon=False)
             build_maps(localizer, data, rooms, out / "maps", spacing=1)
             run_localize(run, out / "maps", data, split="test", out=out)
+            progress()
 
 
 def _full_map_dir(runs: Path, model: str, seed_index: int) -> Path:
@@ -841,6 +865,11 @@ def main() -> None:
         type=float,
         default=1200.0,
         help="seconds of one thread's compute per run (1200: about the old 150's batches)",
+    )
+    go.add_argument(
+        "--doc",
+        type=Path,
+        help="write the tables there (docs/results.md) after each step and evaluation",
     )
     write = sub.add_parser("tables", help="write docs/results.md from the runs")
     write.add_argument("data", type=Path)

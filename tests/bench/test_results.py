@@ -27,8 +27,14 @@ def test_tables_are_the_runs_figures(
         tag="headline",
     )
     record = append_provenance(runs, mini_dataset, step="headline")
-    results.noise_step(mini_dataset, runs, grid=(results.AIM,))  # the aim's point only
+    docs: list[str] = []  # what `run --doc` writes after each evaluation
+    results.noise_step(  # the aim's point only
+        mini_dataset, runs, grid=(results.AIM,), progress=lambda: docs.append(results.tables(runs))
+    )
+    # each evaluation reaches the doc as it ends: 2 models x 2 seeds at the aim's point
+    assert [f"{k} of 14 measured." in d for k, d in enumerate(docs, 1)] == [True] * 4
     doc = results.tables(runs)
+    assert doc == docs[-1]
     # the stamp names the code and the data the runs were made with
     assert f"`{record['commit'][:10]}`" in doc
     assert record["manifest_sha256"][:16] in doc and record["command"] in doc
