@@ -1,6 +1,7 @@
 """A learning curve: triplet accuracy on val and test against the training budget.
 
     python bench/learning_curve.py run DATA RUNS [--budgets 300:3,1200:3,4800:1]
+        [--doc docs/learning-curve.md]
     python bench/learning_curve.py tables RUNS [-o docs/learning-curve.md]
 
 Whether the results' aims are a matter of compute: SeanNet (``seannet-fc512``, the ``cpu``
@@ -29,6 +30,7 @@ import argparse
 import json
 import math
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -79,10 +81,12 @@ def run(
     *,
     preset: str | TrainConfig = "cpu",
     lrs: tuple[float, ...] = LRS,
+    progress: Callable[[], None] = lambda: None,
 ) -> None:
     """Train and evaluate every budget of the curve into ``runs`` (resuming). Each model is
     its own comparison (``selection-curve-<model>.json``), so a later call may carry some
-    models further: a network keeps the batches its first calibration gave it."""
+    models further: a network keeps the batches its first calibration gave it. ``progress``
+    is called after each budget's evaluation."""
     runs.mkdir(parents=True, exist_ok=True)
     append_provenance(runs, data, step=STEP)
     ds = open_dataset(data)
@@ -96,6 +100,7 @@ def run(
         )  # fmt: skip
         chosen[name] = got["models"][0]
     _evaluate(ds, base, list(chosen.values()))
+    progress()
     for budget, seeds in rest:
         # the first budget's calibration, scaled: no second timing
         batches = {
@@ -112,6 +117,7 @@ def run(
             )  # fmt: skip
             entries += got["models"]
         _evaluate(ds, directory, entries)
+        progress()
 
 
 def _tag(name: str) -> str:
@@ -338,6 +344,11 @@ def main() -> None:
         default=",".join(f"{lr:g}" for lr in LRS),
         help="learning rates chosen from on val at the first budget (one: no choice)",
     )
+    go.add_argument(
+        "--doc",
+        type=Path,
+        help="write the page there (docs/learning-curve.md) after each budget's evaluation",
+    )
     write = sub.add_parser("tables", help="write the page and its plot from the runs")
     write.add_argument("runs", type=Path)
     write.add_argument("-o", "--output", type=Path, default=ROOT / "docs" / "learning-curve.md")
@@ -345,11 +356,20 @@ def main() -> None:
     if args.verb == "run":
         models = tuple(m.strip() for m in args.models.split(",") if m.strip())
         lrs = tuple(float(lr) for lr in args.lrs.split(","))
-        run(args.data, args.runs, parse_budgets(args.budgets), models, lrs=lrs)
+        budgets = parse_budgets(args.budgets)
+        # the runs are gitignored and die with the machine: each budget's figures reach a
+        # tracked file as soon as they are measured
+        progress = (lambda: write_page(args.runs, args.doc)) if args.doc else (lambda: None)
+        run(args.data, args.runs, budgets, models, lrs=lrs, progress=progress)
     else:
-        text = tables(args.runs, args.output.with_suffix(".png"))
-        atomic_write_text(args.output, text)
-        print(f"wrote {args.output} and {args.output.with_suffix('.png').name}")
+        write_page(args.runs, args.output)
+
+
+def write_page(runs: Path, output: Path) -> None:
+    """The page and its plot (beside it, ``.png``) from ``runs``, written atomically."""
+    text = tables(runs, output.with_suffix(".png"))
+    atomic_write_text(output, text)
+    print(f"wrote {output} and {output.with_suffix('.png').name}")
 
 
 if __name__ == "__main__":

@@ -20,7 +20,19 @@ def test_curve_scales_the_first_budget_and_writes_the_runs(
     runs = tmp_path / "runs"
     budgets = curve.parse_budgets("0.2:2,0.05:2,0.8:1")  # sorted: 0.05 first
     assert [b for b, _ in budgets] == [0.05, 0.2, 0.8]
-    curve.run(mini_dataset, runs, budgets, ("seannet", "seannet+boxes"), preset=tiny_seannet)
+    page = tmp_path / "docs" / "curve.md"
+    page.parent.mkdir()
+    written = []  # what `run --doc` writes after each budget's evaluation
+
+    def write() -> None:
+        curve.write_page(runs, page)
+        written.append(len(curve.read_curve(runs)["seannet"]))
+
+    curve.run(
+        mini_dataset, runs, budgets, ("seannet", "seannet+boxes"), preset=tiny_seannet,
+        progress=write,
+    )  # fmt: skip
+    assert written == [1, 2, 3]  # a point more each time
 
     points = curve.read_curve(runs)
     assert list(points) == ["seannet", "seannet+boxes"]
@@ -35,9 +47,8 @@ def test_curve_scales_the_first_budget_and_writes_the_runs(
     # the boxes row is the same network's runs (its lr chosen on val with the boxes)
     assert {Path(r["run"]).parent.parent.name for r in rows} == {"seannet"}
 
-    page = tmp_path / "docs" / "curve.md"
-    page.parent.mkdir()
     text = curve.tables(runs, page.with_suffix(".png"))
+    assert page.read_text() == text  # the last write holds every point
     assert page.with_suffix(".png").stat().st_size > 1000
     assert "bench/learning_curve.py" in text and "commit" in text  # stamped
     assert f"{100 * last['test']['mean']:.1f} (1 seed)" in text
