@@ -85,8 +85,9 @@ def run(
 ) -> None:
     """Train and evaluate every budget of the curve into ``runs`` (resuming). Each model is
     its own comparison (``selection-curve-<model>.json``), so a later call may carry some
-    models further: a network keeps the batches its first calibration gave it. ``progress``
-    is called after each budget's evaluation."""
+    models further: a network keeps the batches its first calibration gave it (compare keeps
+    it in the budget's ``calibrations.json``). ``progress`` is called after each budget's
+    evaluation."""
     runs.mkdir(parents=True, exist_ok=True)
     append_provenance(runs, data, step=STEP)
     ds = open_dataset(data)
@@ -96,7 +97,7 @@ def run(
     for name in models:
         got = compare_models(
             ds, base, (name,), preset=preset, seeds=tuple(range(first_seeds)), lrs=lrs,
-            budget_s=first, announce=print, tag=_tag(name), batches=_calibrated(base),
+            budget_s=first, announce=print, tag=_tag(name),
         )  # fmt: skip
         chosen[name] = got["models"][0]
     _evaluate(ds, base, list(chosen.values()))
@@ -122,16 +123,6 @@ def run(
 
 def _tag(name: str) -> str:
     return f"{STEP}-{name.replace('+', '-')}"
-
-
-def _calibrated(directory: Path) -> dict[str, int]:
-    """Batches per epoch of each network calibrated in an earlier comparison here."""
-    found: dict[str, int] = {}
-    for path in sorted(directory.glob(f"selection-{STEP}-*.json")):
-        for m in json.loads(path.read_text())["models"]:
-            if m.get("budget", {}).get("source") == "calibrated":
-                found.setdefault(m["trained"], m["budget"]["batches"])
-    return found
 
 
 def _evaluate(ds: Any, directory: Path, entries: list[dict[str, Any]]) -> None:

@@ -129,9 +129,9 @@ def run_step(
 ) -> None:
     """One step of ``run`` into ``runs`` (``models``: the comparison's, by default the step's
     own of :data:`COMPARISONS`; ``progress``: called after each evaluation of the noise and
-    full-map steps). A comparison reuses the batches a network was calibrated to
-    under the same budget in an earlier step (:func:`_recorded_batches`), and the ``boxes``
-    step trains at the headline SeanNet's lr, so its rows are the headline's runs."""
+    full-map steps). A network calibrated in an earlier step keeps its batches (compare
+    reuses ``runs/calibrations.json``, kept for every step), and the ``boxes`` step trains at
+    the headline SeanNet's lr, so its rows are the headline's runs."""
     if step in COMPARISONS:
         if step == "boxes":
             lrs = (_headline_lr(runs, SEANNET),)
@@ -145,7 +145,6 @@ def run_step(
             budget_s=budget_s,
             announce=print,
             tag=step,
-            batches=_recorded_batches(runs, budget_s),
         )
     elif step == "noise":
         noise_step(data, runs, progress=progress)
@@ -186,15 +185,6 @@ def _calibrations(
             if budget_s is None or budget["budget_s"] == budget_s:
                 found.setdefault(m["trained"], (step, budget))
     return found
-
-
-def _recorded_batches(runs: Path, budget_s: float | None) -> dict[str, int]:
-    """Each trained network's batches per epoch as an earlier step calibrated them under
-    ``budget_s`` by the same rule; networks without such a record are calibrated afresh
-    (a count recorded under another budget or the older clock is not reused)."""
-    if budget_s is None:
-        return {}
-    return {trained: b["batches"] for trained, (_, b) in _calibrations(runs, budget_s).items()}
 
 
 def noise_step(
@@ -280,15 +270,18 @@ def _budget(runs: Path, result: dict[str, Any]) -> str:
     )
 
 
-def _budget_cell(entry: dict[str, Any], calibrations: dict[str, tuple[str, dict]]) -> str:
-    """How ``entry``'s batches were set, from its selection record."""
+def _budget_cell(
+    entry: dict[str, Any], calibrations: dict[str, tuple[str, dict]], step: str
+) -> str:
+    """How ``entry`` (of the comparison ``step``) got its batches, from its selection record."""
     budget = entry.get("budget")
     if not budget:
         return "not recorded"
     if budget["source"] == "preset":
         return "the preset's batches (no budget)"
     if budget["source"] == "calibrated":
-        own = ("here", budget)
+        timed_for = budget.get("timed_for") or step  # an earlier step's, reused
+        own = ("here" if timed_for == step else f"in `{timed_for}`", budget)
     else:  # recorded: the batches of an earlier calibration of the same network
         own = calibrations.get(entry["trained"])
         if own is None or own[1]["batches"] != entry["batches_per_epoch"]:
@@ -323,7 +316,7 @@ def _rule(entry: dict[str, Any], calibrations: dict[str, tuple[str, dict]]) -> t
     return (b["budget_s"], b["clock"]) if "clock" in b else None
 
 
-def _budget_lines(runs: Path, result: dict[str, Any]) -> list[str]:
+def _budget_lines(runs: Path, result: dict[str, Any], step: str) -> list[str]:
     """What each model's budget bought (batches, triplets, the calibration), and whether the
     comparison is like for like: every network's batches set by one budget rule."""
     calibrations = _calibrations(runs, result["budget_s"])
@@ -340,7 +333,7 @@ def _budget_lines(runs: Path, result: dict[str, Any]) -> list[str]:
             f"| {e['model']} | {e['trained']} | {e['batches_per_epoch']} | "
             f"{e.get('epochs', 'not recorded')} | "
             f"{'not recorded' if examples is None else f'{examples:,}'} | "
-            f"{_budget_cell(e, calibrations)} |"
+            f"{_budget_cell(e, calibrations, step)} |"
         )
     rules = {e["model"]: _rule(e, calibrations) for e in result["models"]}
     unknown = [m for m, r in rules.items() if r is None]
@@ -410,7 +403,7 @@ def _stamp(runs: Path, step: str) -> list[str]:
     return [stamp(records), ""] if records else []
 
 
-def _comparison_tables(runs: Path, result: dict[str, Any]) -> list[str]:
+def _comparison_tables(runs: Path, result: dict[str, Any], step: str) -> list[str]:
     lines = [
         f"Preset `{result['preset']}`, {_budget(runs, result)}, learning rate of each "
         "model chosen on "
@@ -436,7 +429,7 @@ def _comparison_tables(runs: Path, result: dict[str, Any]) -> list[str]:
     for e in boxes:
         weights = [r["box_weight"]["lambda"] for r in e["runs"]]
         lines += ["", f"{e['model']}: lambda chosen on val per seed: {weights}."]
-    return [*lines, "", *_budget_lines(runs, result)]
+    return [*lines, "", *_budget_lines(runs, result, step)]
 
 
 def _noise_table(runs: Path, result: dict[str, Any]) -> list[str]:
@@ -616,7 +609,7 @@ def _comparison_section(
         "",
         *_stamp(runs, step),
         *said,
-        *_comparison_tables(runs, result),
+        *_comparison_tables(runs, result, step),
     ]
 
 
@@ -709,7 +702,7 @@ def tables(runs: Path) -> str:
         "",
         "## SeanNet, the box-overlap baseline and ResNet-18",
         "",
-        *_comparison_tables(runs, head),
+        *_comparison_tables(runs, head, "headline"),
         "",
         "## Under labeler / detector box noise",
         "",

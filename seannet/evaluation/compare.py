@@ -154,22 +154,25 @@ def compare_models(
     specs = [model_spec(name, base) for name in models]  # refuse a bad spec before work
     ds = open_dataset(data)  # the manifest read once for the whole comparison
     batches = dict(batches or {})
-    calibrations: dict[str, Calibration] = {}
+    calibrations: dict[str, tuple[Calibration, str]] = {}  # and the comparison timed for
     chosen = []
     for spec in specs:
         config = spec.config
         if budget_s is not None or spec.trained in batches:
             if spec.trained not in batches:
                 calibrations[spec.trained] = _calibration(
-                    spec.trained, config, base, ds, out, budget_s, say
+                    spec.trained, config, base, ds, out, budget_s, say, tag
                 )
-                batches[spec.trained] = calibrations[spec.trained].batches
+                batches[spec.trained] = calibrations[spec.trained][0].batches
             config = config.replace(max_train_batches=batches[spec.trained])
         choice = _select(spec, config, ds, out, seeds, lrs or (config.lr,), say)
-        got = calibrations.get(spec.trained)
-        # what the budget bought and how it was measured; or where the batches came from
-        source = "recorded" if spec.trained in batches else "preset"
-        choice["budget"] = {"source": "calibrated", **got.to_dict()} if got else {"source": source}
+        # what the budget bought, how it was measured and for which comparison (an earlier
+        # one under ``out`` whose calibration this one reuses); or where the batches came from
+        if spec.trained in calibrations:
+            got, timed_for = calibrations[spec.trained]
+            choice["budget"] = {"source": "calibrated", **got.to_dict(), "timed_for": timed_for}
+        else:
+            choice["budget"] = {"source": "recorded" if spec.trained in batches else "preset"}
         chosen.append(choice)
     selection = {
         "preset": preset if isinstance(preset, str) else "custom",
@@ -246,8 +249,10 @@ def _calibration(
     out: Path,
     budget_s: float,
     say: Callable[[str], None],
-) -> Calibration:
-    """The calibration that sets ``trained``'s batches for the runs under ``out``.
+    tag: str,
+) -> tuple[Calibration, str]:
+    """The calibration that sets ``trained``'s batches for the runs under ``out``, and the
+    tag of the comparison it was first taken for (``tag`` when taken now).
 
     The first one taken is kept in ``out/calibrations.json`` (before any run trains) and
     reused by every later call with the same network, budget and step shape: a comparison
@@ -274,7 +279,7 @@ def _calibration(
                 f"{trained}: {got.batches} batches per epoch, as calibrated for these runs at "
                 f"{record['taken']['started']} (a step {got.step_s:.3f} s; {path})"
             )
-            return got
+            return got, record.get("comparison", "")
     got = _calibrate(trained, config, ds, budget_s, say)
     first = next((r for r in records if {**r["key"], "trained": trained} == key), None)
     here = (os.getpid(), PROCESS.loaded)
@@ -288,10 +293,10 @@ def _calibration(
             f"{got.converted_by['reference_then_s']:.3f} s, here {now:.3f} s)"
         )
     taken = provenance_record(None, step="calibrate")  # when, by which code and command
-    records.append({"key": key, "taken": taken, "calibration": got.to_dict()})
+    records.append({"key": key, "taken": taken, "comparison": tag, "calibration": got.to_dict()})
     out.mkdir(parents=True, exist_ok=True)
     atomic_write_text(path, json.dumps(records, indent=2))
-    return got
+    return got, tag
 
 
 def _read_calibrations(path: Path) -> list[dict[str, Any]]:

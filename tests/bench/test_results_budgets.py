@@ -50,15 +50,22 @@ def test_sections_compare_like_for_like(
     # the boxes step trains at the headline SeanNet's lr only: both rows are its runs
     assert boxes["lrs"] == [head[ours]["lr"]]
     assert all(m["runs"] == head[ours]["runs"] for m in boxes["models"])
-    # the ablations' SeanNet keeps the headline's calibrated batches; the image branch is
-    # calibrated by the same rule under the same budget
+    # the ablations' SeanNet keeps the headline's calibration (calibrations.json, one record
+    # per network) and says whose it is; the image branch is calibrated by the same rule under
+    # the same budget, for the ablations
     ablations = {
         m["model"]: m for m in json.loads((runs / "selection-ablations.json").read_text())["models"]
     }
-    assert ablations[ours]["budget"]["source"] == "recorded"
-    assert ablations[ours]["batches_per_epoch"] == head[ours]["budget"]["batches"]
-    assert ablations["seannet-image"]["budget"]["source"] == "calibrated"
+    assert ablations[ours]["budget"] == head[ours]["budget"]
+    assert ablations[ours]["budget"]["timed_for"] == "headline"
+    assert ablations["seannet-image"]["budget"]["timed_for"] == "ablations"
     assert ablations["seannet-image"]["budget"]["budget_s"] == BUDGET_S
+    kept = json.loads((runs / "calibrations.json").read_text())
+    assert [(r["key"]["trained"], r["comparison"]) for r in kept] == [
+        (ours, "headline"),
+        ("resnet18", "headline"),
+        ("seannet-image", "ablations"),
+    ]
 
     doc = results.tables(runs)
     section = _section(doc, "SeanNet plus the hand-made overlap")
@@ -75,6 +82,7 @@ def test_sections_compare_like_for_like(
         )
         assert row in section
     assert f"| {ours} | {ours} | " in section and "calibrated in `headline`" in section
+    assert "| seannet-image | seannet-image | " in section and "calibrated here" in section
     assert f"Like for like: every network's batches fill the same {BUDGET_S:g} s" in section
 
     # a section whose runs are not the headline's says so, and names why
@@ -106,7 +114,7 @@ def test_a_network_timed_on_a_later_machine_says_so() -> None:
     results = load_bench("results")
     budget = {"source": "calibrated", "budget_s": 1200.0, "step_s": 3.1, "spread": 0.05}
     entry = {"trained": "seannet", "batches_per_epoch": 77, "budget": budget}
-    assert results._budget_cell(entry, {}) == (
+    assert results._budget_cell(entry, {}, "fc") == (
         "calibrated here: 1200 s, a step 3.100 s, rounds 5 % apart"
     )
     converted = {
@@ -116,7 +124,7 @@ def test_a_network_timed_on_a_later_machine_says_so() -> None:
         "timed_s": 6.2,
     }
     entry["budget"] = {**budget, "converted_by": converted}
-    assert results._budget_cell(entry, {}).endswith(
+    assert results._budget_cell(entry, {}, "fc").endswith(
         "(timed 6.200 s on a later machine, put in the first one's seconds by resnet18's "
         "step: 2.000 s there, 4.000 s here)"
     )

@@ -115,7 +115,9 @@ def test_a_resumed_comparison_trains_the_batches_its_calibration_kept(
     first = compare_models(mini_dataset, out, ["resnet18"], **ask)["models"][0]
     kept = json.loads((out / CALIBRATIONS).read_text())
     assert [r["key"]["trained"] for r in kept] == ["resnet18"]
-    assert {**kept[0]["calibration"], "source": "calibrated"} == first["budget"]
+    # the selection holds the record and the comparison it was timed for (untagged: "")
+    assert kept[0]["comparison"] == ""
+    assert {**kept[0]["calibration"], "source": "calibrated", "timed_for": ""} == first["budget"]
     (out / SELECTION).unlink()
     again = compare_models(mini_dataset, out, ["resnet18"], **ask)["models"][0]
     assert again["budget"] == first["budget"]  # the same timing, not a new one
@@ -165,7 +167,7 @@ def test_a_network_timed_on_a_later_machine_gets_the_first_machines_seconds(
     assert graph["batches"] == models[1]["batches_per_epoch"] == max(1, int(1000 / graph["step_s"]))
     kept = json.loads((out / CALIBRATIONS).read_text())
     assert [r["key"]["trained"] for r in kept] == ["resnet18", "seannet-graph"]
-    assert {**kept[1]["calibration"], "source": "calibrated"} == graph
+    assert {**kept[1]["calibration"], "source": "calibrated", "timed_for": ""} == graph
 
 
 @pytest.mark.parametrize("text", ["{not json", "[1, 2]", '[{"key": {}}]'])
