@@ -280,7 +280,7 @@ def _budget_cell(
     if budget["source"] == "preset":
         return "the preset's batches (no budget)"
     if budget["source"] == "calibrated":
-        timed_for = budget.get("timed_for") or step  # an earlier step's, reused
+        timed_for = budget.get("timed_for") or step  # unnamed (an untagged compare): this one
         own = ("here" if timed_for == step else f"in `{timed_for}`", budget)
     else:  # recorded: the batches of an earlier calibration of the same network
         own = calibrations.get(entry["trained"])

@@ -50,10 +50,10 @@ from seannet.evaluation.compare import model_spec  # noqa: E402
 from seannet.model.loss import TripletLoss  # noqa: E402
 from seannet.model.seannet import SeanNet  # noqa: E402
 from seannet.model.specs import parse_spec  # noqa: E402
-from seannet.training.budget import CPU_CLOCK, GPU_CLOCK, calibrate  # noqa: E402
+from seannet.training.budget import calibrate  # noqa: E402
 from seannet.training.config import TrainConfig, preset  # noqa: E402
 from seannet.training.loop import train_one_epoch, triplet_step  # noqa: E402
-from seannet.training.runs import build_for_dataset, device_for_run  # noqa: E402
+from seannet.training.runs import build_for_dataset  # noqa: E402
 
 # the networks docs/results.md trains (a scene term adds no training step), ResNet-18 first
 RESULTS_NETWORKS = tuple(
@@ -104,26 +104,24 @@ def step_costs(
     data: Path, models: Sequence[str], base: TrainConfig, budget_s: float
 ) -> dict[str, Any]:
     """Each network's step as the budget times it, and what ``budget_s`` buys it."""
-    rows = []
-    for spec in models:
-        got = calibrate(model_spec(spec, base).config, data, budget_s)
-        rows.append(
-            {
-                "network": spec,
-                "step_s": got.step_s,
-                "spread": got.spread,
-                "busy": got.busy,
-                "batches": got.batches,
-                "examples": got.examples,
-            }
-        )
-    for row in rows:
-        row["step_ratio"] = row["step_s"] / rows[0]["step_s"]
+    timed = [calibrate(model_spec(spec, base).config, data, budget_s) for spec in models]
+    rows = [
+        {
+            "network": spec,
+            "step_s": got.step_s,
+            "spread": got.spread,
+            "busy": got.busy,
+            "batches": got.batches,
+            "examples": got.examples,
+            "step_ratio": got.step_s / timed[0].step_s,
+        }
+        for spec, got in zip(models, timed, strict=True)
+    ]
     return {
         "budget_s": budget_s,
         "batch_size": base.batch_size,
         "epochs": base.epochs,
-        "clock": CPU_CLOCK if device_for_run().type == "cpu" else GPU_CLOCK,
+        "clock": timed[0].clock,
         "networks": rows,
     }
 
