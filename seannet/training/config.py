@@ -96,9 +96,9 @@ PRESETS: dict[str, TrainConfig] = {
     "paper": TrainConfig(),  # every default: ModelConfig's and the fields above
     # Two CPU cores in about half an hour for SeanNet: the short schedule at 112 px (C4 7 x 7,
     # RoIAlign 7), 24 batches an epoch. Its model is seannet-fc512 (the GCN's fc 512 wide, not
-    # the paper's 4,096): as accurate on val and test, a step 1.19x ResNet-18's instead of
-    # 1.55x (docs/benchmarks-2026-12-02.md, docs/results.md). Loader workers would only compete with
-    # torch for the two cores.
+    # the paper's 4,096): as accurate on val and test, a step near ResNet-18's (docs/results.md;
+    # docs/benchmarks.md, "A training step"). Loader workers would only compete with torch for
+    # the two cores.
     "cpu": TrainConfig().replace(
         model="seannet-fc512",
         **_SHORT_SCHEDULE,
