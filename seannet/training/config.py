@@ -96,9 +96,9 @@ PRESETS: dict[str, TrainConfig] = {
     "paper": TrainConfig(),  # every default: ModelConfig's and the fields above
     # Two CPU cores in about half an hour for SeanNet: the short schedule at 112 px (C4 7 x 7,
     # RoIAlign 7), 24 batches an epoch. Its model is seannet-fc512 (the GCN's fc 512 wide, not
-    # the paper's 4,096): as accurate on val and test, a step near ResNet-18's (docs/results.md;
-    # docs/benchmarks.md, "A training step"). Loader workers would only compete with torch for
-    # the two cores.
+    # the paper's 4,096): a step near ResNet-18's (docs/benchmarks.md, "A training step"), as
+    # accurate under wave 3's protocol (docs/training.md, presets). Loader workers would only
+    # compete with torch for the two cores.
     "cpu": TrainConfig().replace(
         model="seannet-fc512",
         **_SHORT_SCHEDULE,
