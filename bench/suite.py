@@ -71,6 +71,21 @@ AIMS = {
 }
 
 
+SETTLE_LOAD = 0.5  # per core: the 1-minute load average a measure waits for before it starts
+
+
+def settle(max_s: float) -> float:
+    """Wait, at most ``max_s`` seconds, for the 1-minute load average to fall to
+    :data:`SETTLE_LOAD` per core, so that what the previous measure left winding down (Ray's
+    processes, two generate workers) does not run on the next one's clock; the seconds
+    waited."""
+    limit = SETTLE_LOAD * (os.cpu_count() or 1)
+    start = time.monotonic()
+    while os.getloadavg()[0] > limit and time.monotonic() - start < max_s:
+        time.sleep(2)
+    return round(time.monotonic() - start, 1)
+
+
 def machine_stamp() -> dict[str, Any]:
     """The code and the machine now: commit and dirty flag, CPU, cores, memory, GPU, the
     1-minute load average, the date (UTC)."""
@@ -346,7 +361,8 @@ def run_measure(name: str, args: argparse.Namespace, tiny: Path, out: Path) -> d
     """Run one measure's commands, each in a fresh process; write ``out/<name>.json``
     (atomically) with the stamp taken at its start, the commands and the parsed figures."""
     measure = MEASURES[name]
-    stamp = machine_stamp()
+    settled = settle(args.settle)
+    stamp = {**machine_stamp(), "settled_s": settled}
     env = {**os.environ, **(measure.env or {})}
     commands = measure.commands(args, tiny)
     outputs, start = [], time.perf_counter()
@@ -373,8 +389,13 @@ def _stamp_line(record: dict[str, Any]) -> str:
     return (
         f"*Measured {s['date']} at commit `{s['commit'][:10]}`{dirty} on {s['cores']} x "
         f"{s['cpu']}, {s['memory_gib']} GiB, GPU {s['gpu']}, load average "
-        f"{s['load_average']:.2f} at the start: {commands}.*"
+        f"{s['load_average']:.2f} at the start{_settled(s)}: {commands}.*"
     )
+
+
+def _settled(stamp: dict[str, Any]) -> str:
+    waited = stamp.get("settled_s", 0)
+    return f" (after {waited:g} s waiting for it to settle)" if waited else ""
 
 
 def _short(arg: str) -> str:
@@ -454,6 +475,13 @@ def main() -> None:
     go.add_argument("--rooms", type=int, default=24, help="rooms of the generate runs")
     go.add_argument("--views", type=int, default=30, help="views per room of the render run")
     go.add_argument("--validate", type=Path, help="dataset to validate (default: tiny)")
+    go.add_argument(
+        "--settle",
+        type=float,
+        default=120.0,
+        help=f"seconds at most to wait before each measure for the load to fall to "
+        f"{SETTLE_LOAD:g} per core",
+    )
     go.add_argument("--only", help=f"these measures only, comma-separated ({', '.join(CORE)})")
     go.add_argument("--extras", default="", help=f"also run these ({', '.join(EXTRAS)})")
     go.add_argument("-o", "--output", type=Path, default=PAGE)

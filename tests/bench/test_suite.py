@@ -14,7 +14,7 @@ from ..bench_scripts import load_bench
 def test_the_page_is_the_scripts_figures(tmp_path: Path, mini_dataset: Path) -> None:
     suite = load_bench("suite")
     out = tmp_path / "bench"
-    args = argparse.Namespace(views=2, rooms=1, validate=None)
+    args = argparse.Namespace(views=2, rooms=1, validate=None, settle=0.0)
     # real measures on the mini dataset: sgdata validate, and the channels script's JSON
     validate = suite.run_measure("validate", args, mini_dataset, out)
     channels = suite.run_measure("channels", args, mini_dataset, out)
@@ -33,7 +33,8 @@ def test_the_page_is_the_scripts_figures(tmp_path: Path, mini_dataset: Path) -> 
         {"views": 70, "wall_s": 4.375, "views_per_s": 16.0},
         {"views": 70, "wall_s": 3.5, "views_per_s": 20.0},
     ]
-    record = {"measure": "generate", "stamp": stamp, "commands": [["x"]], "result": runs}
+    settled = {**stamp, "settled_s": 54.0}  # it waited for the load to fall before it ran
+    record = {"measure": "generate", "stamp": settled, "commands": [["x"]], "result": runs}
     (out / "generate.json").write_text(json.dumps(record))
     # a train record as bench/train_step.py --json prints it: its rows, as measured
     steps = {
@@ -54,12 +55,14 @@ def test_the_page_is_the_scripts_figures(tmp_path: Path, mini_dataset: Path) -> 
     dirty = " with uncommitted changes" if stamp["dirty"] else ""
     assert f"at commit `{stamp['commit'][:10]}`{dirty} on {stamp['cores']} x {stamp['cpu']}" in doc
     assert f"load average {stamp['load_average']:.2f} at the start" in doc
+    assert stamp["settled_s"] == 0  # --settle 0: no wait, and the page says none
     assert stamp["date"] in doc
     assert f"| `{mini_dataset.name}` | {validate['result']['seconds']:.1f} |" in doc
     result = channels["result"]
     assert f"| channels / RGB only | {result['ratio']:.2f}x | >= 0.85x |" in doc
     assert f"| PNG bytes per view, image | {result['bytes_per_view']['image']:,} |" in doc
     assert "| local, 1 worker: 70 views in 7.0 s, 8.75 s | 10.00 views/s |  |" in doc
+    assert "at the start (after 54 s waiting for it to settle): `x`" in doc
     assert "| **2 workers / 1** | 2.00x (rounds 2.00x to 2.00x) | >= 1.8x |" in doc
     assert "| **Ray local / local pool** | 1.00x (rounds 0.88x to 1.25x) | >= 0.8x |" in doc
     assert "| `seannet` | 4.250 | 1.70x | 31 % | 0 % | 56 |" in doc
