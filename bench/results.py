@@ -170,23 +170,6 @@ def _selections(runs: Path) -> list[tuple[str, dict[str, Any]]]:
     ]
 
 
-def _calibrations(
-    runs: Path, budget_s: float | None = None
-) -> dict[str, tuple[str, dict[str, Any]]]:
-    """Each trained network's calibration record (its step, the record) among the selections
-    of ``runs`` (under ``budget_s`` when given): the first calibrated by the one-thread rule
-    (``clock`` recorded), in the steps' name order."""
-    found: dict[str, tuple[str, dict[str, Any]]] = {}
-    for step, selection in _selections(runs):
-        for m in selection["models"]:
-            budget = m.get("budget") or {}
-            if budget.get("source") != "calibrated" or "clock" not in budget:
-                continue
-            if budget_s is None or budget["budget_s"] == budget_s:
-                found.setdefault(m["trained"], (step, budget))
-    return found
-
-
 def noise_step(
     data: Path,
     runs: Path,
@@ -252,14 +235,12 @@ def _span(entry: dict[str, float], sign: bool = False) -> str:
     return f"{f(entry['mean'])} [{f(entry['low'])}, {f(entry['high'])}]"
 
 
-def _budget(runs: Path, result: dict[str, Any]) -> str:
-    """What the comparison's budget meant, from its records (a step that reused an earlier
-    step's batches is read through that step's calibration)."""
+def _budget(result: dict[str, Any]) -> str:
+    """What the comparison's budget meant, from its records."""
     seconds = result["budget_s"]
     if seconds is None:
         return "the preset's batches per epoch for every model"
-    calibrations = _calibrations(runs, seconds)
-    if any(_rule(e, calibrations) not in (None, ("preset",)) for e in result["models"]):
+    if any(_rule(e) not in (None, ("preset",)) for e in result["models"]):
         return (
             f"{seconds:g} s of one thread's compute per run (each network's batches per epoch "
             "from its timed steps; what each got: below)"
@@ -270,24 +251,18 @@ def _budget(runs: Path, result: dict[str, Any]) -> str:
     )
 
 
-def _budget_cell(
-    entry: dict[str, Any], calibrations: dict[str, tuple[str, dict]], step: str
-) -> str:
-    """How ``entry`` (of the comparison ``step``) got its batches, from its selection record."""
-    budget = entry.get("budget")
-    if not budget:
+def _budget_cell(entry: dict[str, Any], step: str) -> str:
+    """How ``entry`` (of the comparison ``step``) got its batches, from its selection record
+    (a calibration reused from ``calibrations.json`` names the step it was timed for)."""
+    b = entry.get("budget")
+    if not b:
         return "not recorded"
-    if budget["source"] == "preset":
+    if b["source"] == "preset":
         return "the preset's batches (no budget)"
-    if budget["source"] == "calibrated":
-        timed_for = budget.get("timed_for") or step  # unnamed (an untagged compare): this one
-        own = ("here" if timed_for == step else f"in `{timed_for}`", budget)
-    else:  # recorded: the batches of an earlier calibration of the same network
-        own = calibrations.get(entry["trained"])
-        if own is None or own[1]["batches"] != entry["batches_per_epoch"]:
-            return "recorded (no calibration of it among these runs)"
-        own = (f"in `{own[0]}`", own[1])
-    where, b = own
+    if b["source"] != "calibrated":  # batches handed to compare, no calibration behind them
+        return "handed in (not calibrated)"
+    timed_for = b.get("timed_for") or step  # unnamed (an untagged compare): this one
+    where = "here" if timed_for == step else f"in `{timed_for}`"
     said = (
         f"calibrated {where}: {b['budget_s']:g} s, a step {b['step_s']:.3f} s, rounds "
         f"{100 * b['spread']:.0f} % apart"
@@ -302,24 +277,20 @@ def _budget_cell(
     return said
 
 
-def _rule(entry: dict[str, Any], calibrations: dict[str, tuple[str, dict]]) -> tuple | None:
+def _rule(entry: dict[str, Any]) -> tuple | None:
     """The budget rule behind ``entry``'s batches: (seconds, clock), ("preset",), or None
-    when it is not recorded."""
-    budget = entry.get("budget")
-    if not budget:
+    when no calibration is recorded."""
+    b = entry.get("budget")
+    if not b:
         return None
-    if budget["source"] == "preset":
+    if b["source"] == "preset":
         return ("preset",)
-    b = budget
-    if budget["source"] != "calibrated":
-        b = calibrations.get(entry["trained"], ("", {}))[1]
-    return (b["budget_s"], b["clock"]) if "clock" in b else None
+    return (b["budget_s"], b["clock"]) if b["source"] == "calibrated" and "clock" in b else None
 
 
-def _budget_lines(runs: Path, result: dict[str, Any], step: str) -> list[str]:
+def _budget_lines(result: dict[str, Any], step: str) -> list[str]:
     """What each model's budget bought (batches, triplets, the calibration), and whether the
     comparison is like for like: every network's batches set by one budget rule."""
-    calibrations = _calibrations(runs, result["budget_s"])
     lines = [
         "What each model's budget bought (`selection.json`'s records; triplets per run: "
         "batches per epoch × batch size × epochs):",
@@ -333,16 +304,16 @@ def _budget_lines(runs: Path, result: dict[str, Any], step: str) -> list[str]:
             f"| {e['model']} | {e['trained']} | {e['batches_per_epoch']} | "
             f"{e.get('epochs', 'not recorded')} | "
             f"{'not recorded' if examples is None else f'{examples:,}'} | "
-            f"{_budget_cell(e, calibrations, step)} |"
+            f"{_budget_cell(e, step)} |"
         )
-    rules = {e["model"]: _rule(e, calibrations) for e in result["models"]}
+    rules = {e["model"]: _rule(e) for e in result["models"]}
     unknown = [m for m, r in rules.items() if r is None]
     if unknown:
         said = (
             f"Like for like not shown: {', '.join(unknown)} "
             f"{'has' if len(unknown) == 1 else 'have'} no budget record (runs made before "
-            "budgets were recorded, 2026-12-02), so the batches cannot be told to come from "
-            "one rule."
+            "budgets were recorded, 2026-12-02, or batches handed in), so the batches cannot be "
+            "told to come from one rule."
         )
     elif len(set(rules.values())) == 1:
         rule = next(iter(rules.values()))
@@ -405,7 +376,7 @@ def _stamp(runs: Path, step: str) -> list[str]:
 
 def _comparison_tables(runs: Path, result: dict[str, Any], step: str) -> list[str]:
     lines = [
-        f"Preset `{result['preset']}`, {_budget(runs, result)}, learning rate of each "
+        f"Preset `{result['preset']}`, {_budget(result)}, learning rate of each "
         "model chosen on "
         f"the whole val split from {result['lrs']} with seed {result['seeds'][0]}, then seeds "
         f"{result['seeds']} at it; test read once, after `selection.json` was written.",
@@ -429,7 +400,7 @@ def _comparison_tables(runs: Path, result: dict[str, Any], step: str) -> list[st
     for e in boxes:
         weights = [r["box_weight"]["lambda"] for r in e["runs"]]
         lines += ["", f"{e['model']}: lambda chosen on val per seed: {weights}."]
-    return [*lines, "", *_budget_lines(runs, result, step)]
+    return [*lines, "", *_budget_lines(result, step)]
 
 
 def _noise_table(runs: Path, result: dict[str, Any]) -> list[str]:

@@ -114,7 +114,7 @@ def test_a_network_timed_on_a_later_machine_says_so() -> None:
     results = load_bench("results")
     budget = {"source": "calibrated", "budget_s": 1200.0, "step_s": 3.1, "spread": 0.05}
     entry = {"trained": "seannet", "batches_per_epoch": 77, "budget": budget}
-    assert results._budget_cell(entry, {}, "fc") == (
+    assert results._budget_cell(entry, "fc") == (
         "calibrated here: 1200 s, a step 3.100 s, rounds 5 % apart"
     )
     converted = {
@@ -124,7 +124,7 @@ def test_a_network_timed_on_a_later_machine_says_so() -> None:
         "timed_s": 6.2,
     }
     entry["budget"] = {**budget, "converted_by": converted}
-    assert results._budget_cell(entry, {}, "fc").endswith(
+    assert results._budget_cell(entry, "fc").endswith(
         "(timed 6.200 s on a later machine, put in the first one's seconds by resnet18's "
         "step: 2.000 s there, 4.000 s here)"
     )
