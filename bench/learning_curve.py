@@ -350,7 +350,10 @@ def main() -> None:
         budgets = parse_budgets(args.budgets)
         # the runs are gitignored and die with the machine: each budget's figures reach a
         # tracked file as soon as they are measured
-        progress = (lambda: write_page(args.runs, args.doc)) if args.doc else (lambda: None)
+        progress = lambda: None  # noqa: E731
+        if args.doc:  # its folder now, not after the first budget's runs
+            args.doc.parent.mkdir(parents=True, exist_ok=True)
+            progress = lambda: write_page(args.runs, args.doc)  # noqa: E731
         run(args.data, args.runs, budgets, models, lrs=lrs, progress=progress)
     else:
         write_page(args.runs, args.output)

@@ -101,6 +101,8 @@ FULL_MAP = "localize_test.json"  # what `seannet localize --split test` writes p
 def run(args: argparse.Namespace) -> None:
     runs: Path = args.runs
     runs.mkdir(parents=True, exist_ok=True)
+    if args.doc:  # its folder now, not hours later when the headline is done
+        args.doc.parent.mkdir(parents=True, exist_ok=True)
 
     def write_doc() -> None:
         # what is measured reaches the tree at once: a tracked file survives where a stopped

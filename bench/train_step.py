@@ -46,6 +46,7 @@ sys.path.append(str(BENCH))  # for results.py; last, so no bench script shadows 
 from results import ABLATIONS, FC, HEADLINE  # noqa: E402
 
 from seannet.data.datasets import ImageTransform, TripletDataset, collate_triplets  # noqa: E402
+from seannet.errors import ModelError  # noqa: E402
 from seannet.evaluation.compare import model_spec  # noqa: E402
 from seannet.model.loss import TripletLoss  # noqa: E402
 from seannet.model.seannet import SeanNet  # noqa: E402
@@ -96,7 +97,10 @@ def main() -> None:
     elif args.gcn_forms:
         gcn_forms(base.replace(model="seannet"), args.data, args.steps)
     else:
-        figures = step_costs(args.data, args.models, base, args.budget)
+        try:
+            figures = step_costs(args.data, args.models, base, args.budget)
+        except ModelError as error:  # an unknown network: the registry's choices, one line
+            raise SystemExit(f"--models: {error}") from None
         print(json.dumps(figures) if args.json else step_report(figures))
 
 
@@ -104,7 +108,8 @@ def step_costs(
     data: Path, models: Sequence[str], base: TrainConfig, budget_s: float
 ) -> dict[str, Any]:
     """Each network's step as the budget times it, and what ``budget_s`` buys it."""
-    timed = [calibrate(model_spec(spec, base).config, data, budget_s) for spec in models]
+    configs = [model_spec(spec, base).config for spec in models]  # a bad name before timing
+    timed = [calibrate(config, data, budget_s) for config in configs]
     rows = [
         {
             "network": spec,

@@ -108,3 +108,14 @@ def test_step_costs_are_the_budgets_calibration_and_branch_motion_trains_by_the_
 
 def _branch_parts() -> list[str]:
     return list(load_bench("branch_motion").PARTS)
+
+
+def test_an_unknown_network_is_one_line_before_any_timing(mini_dataset: Path) -> None:
+    done = subprocess.run(
+        [sys.executable, str(BENCH / "train_step.py"), str(mini_dataset), "--models",
+         "resnet18,nope"],
+        capture_output=True, text=True, check=False,
+    )  # fmt: skip
+    assert done.returncode == 1 and "Traceback" not in done.stderr
+    assert done.stderr.startswith("--models: model 'nope': unknown name 'nope'")
+    assert len(done.stderr.strip().splitlines()) == 1 and done.stdout == ""
