@@ -1,5 +1,9 @@
 # The two entry points of README.md; both set the machine up first (idempotent).
-.PHONY: setup demo test lint
+# The suite runs on every core (pytest-xdist, -n auto): shared artefacts are built once under a
+# file lock (tests/artefacts.py), and tests marked `quiet` run while the other workers wait.
+.PHONY: setup demo test test-fast test-random test-coverage lint
+
+PYTEST = .venv/bin/python -m pytest -n auto --dist loadfile
 
 setup:
 	bash scripts/setup.sh
@@ -8,7 +12,19 @@ demo: setup
 	bash scripts/demo.sh out/demo
 
 test: setup
-	.venv/bin/python -m pytest -q
+	$(PYTEST) -q
+
+# the inner loop: everything but the tests marked `slow` (each says why it is)
+test-fast: setup
+	$(PYTEST) -q -m "not slow"
+
+# the suite in a shuffled order; the seed it prints repeats an order (-p randomly -p "randomly_seed=N")
+test-random: setup
+	$(PYTEST) -q -p randomly
+
+# branch coverage of sgdata, seannet and the CLI, in-process code only
+test-coverage: setup
+	$(PYTEST) -q --cov=sgdata --cov=seannet --cov=cli --cov-branch --cov-report=term:skip-covered
 
 lint: setup
 	.venv/bin/ruff check . && .venv/bin/ruff format --check .

@@ -27,7 +27,12 @@ Measures:
 - validate: ``sgdata validate`` on a dataset (``--validate``, default that ``tiny`` one);
 - train: ``bench/train_step.py`` on that ``tiny`` one: each network docs/results.md trains,
   its step timed by the training budget's own rule and the batches ``1200`` s buy it;
-- extras (``--extras``): ``bench/channels.py``, ``bench/assets.py``, ``bench/fuzz.py``.
+- extras (``--extras``): ``bench/channels.py``, ``bench/assets.py``, ``bench/fuzz.py``,
+  ``bench/tests.py`` (the test suite as README.md runs it, ``make test`` and ``make test-fast``).
+
+``page`` keeps the section of a measure with no file in ``OUT`` as the current page has it
+(its own stamp says when and at which commit it was measured), so one measure can be re-run
+alone without losing the others.
 """
 
 from __future__ import annotations
@@ -59,7 +64,7 @@ PAGE = ROOT / "docs" / "benchmarks.md"
 # the hand-assembled page this generator replaced: its figures, each naming its commit
 OLDER = ROOT / "docs" / "benchmarks-2026-12-02.md"
 CORE = ("render", "generate", "loader", "validate", "train")
-EXTRAS = ("channels", "assets", "fuzz")
+EXTRAS = ("channels", "assets", "fuzz", "tests")
 # the ratios the project holds itself to (issue 25): aims, not measurements
 AIMS = {
     "textured: pipeline/naive": ">= 2x",
@@ -290,6 +295,38 @@ def _fuzz_section(reports: list[dict[str, Any]]) -> list[str]:
     return _table(("surface", "tried", "refused", "failures", "seconds"), rows)
 
 
+def _tests_commands(args: argparse.Namespace, tiny: Path) -> list[list[str]]:
+    script = str(BENCH / "tests.py")
+    return [[PY, script, "--json"], [PY, script, "--target", "test-fast", "--json"]]
+
+
+def _tests_section(runs: list[dict[str, Any]]) -> list[str]:
+    """Each target's wall time, outcomes and peak disk; the full suite's slowest ten."""
+    rows = [
+        (
+            f"`make {r['target']}`",
+            f"{r['wall_s']:.0f} s ({r['wall_s'] / 60:.1f} min)",
+            ", ".join(f"{n} {kind}" for kind, n in sorted(r["outcomes"].items())),
+            f"{r['test_seconds']:.0f} s",
+            f"{r['peak_disk_mb']:,} MB",
+        )
+        for r in runs
+    ]
+    lines = _table(("command", "wall time", "tests", "sum of test times", "peak disk"), rows)
+    full = next((r for r in runs if r["target"] == "test"), None)
+    if full:
+        lines += [
+            "",
+            f"The slowest ten of `make {full['target']}` (set-up, call and teardown):",
+            "",
+            *_table(
+                ("test", "seconds"),
+                [(f"`{c['test']}`", f"{c['seconds']:.1f}") for c in full["slowest"]],
+            ),
+        ]
+    return lines
+
+
 def _table(header: tuple[str, ...], rows: list[tuple[str, ...]]) -> list[str]:
     return [
         "| " + " | ".join(header) + " |",
@@ -354,6 +391,12 @@ MEASURES: dict[str, Measure] = {
         lambda outs, _s, _c: _json_lines(outs[0]),
         _fuzz_section,
     ),
+    "tests": Measure(
+        "The test suite (`bench/tests.py`)",
+        _tests_commands,
+        lambda outs, _s, _c: [_last_json(o) for o in outs],
+        _tests_section,
+    ),
 }
 
 
@@ -368,7 +411,8 @@ def run_measure(name: str, args: argparse.Namespace, tiny: Path, out: Path) -> d
     outputs, start = [], time.perf_counter()
     for command in commands:
         done = subprocess.run(command, capture_output=True, text=True, env=env, check=False)
-        if done.returncode != 0 and name != "fuzz":  # fuzz exits 1 when it found a failure
+        # fuzz exits 1 when it found a failure; tests reports the suite's own return code
+        if done.returncode != 0 and name not in ("fuzz", "tests"):
             raise SystemExit(f"{name}: {' '.join(command)} failed:\n{done.stderr[-2000:]}")
         outputs.append(done.stdout)
     seconds = time.perf_counter() - start
@@ -425,8 +469,23 @@ def _older_section(older: Path) -> list[str]:
     ]
 
 
-def page(out: Path, older: Path = OLDER) -> str:
-    """docs/benchmarks.md from the measures' files under ``out``."""
+def _sections(text: str) -> dict[str, list[str]]:
+    """A page's measure sections by title, each as its lines (title to the next section)."""
+    sections: dict[str, list[str]] = {}
+    title = None
+    for line in text.splitlines():
+        if line.startswith("## "):
+            title = line.removeprefix("## ")
+            sections[title] = []
+        elif title is not None:
+            sections[title].append(line)
+    return {t: lines[:-1] if lines and not lines[-1] else lines for t, lines in sections.items()}
+
+
+def page(out: Path, older: Path = OLDER, current: str = "") -> str:
+    """docs/benchmarks.md from the measures' files under ``out``; a measure with no file keeps
+    its section from ``current`` (the page as it stands), stamp and all."""
+    kept = _sections(current)
     lines = [
         "# Benchmarks",
         "",
@@ -439,7 +498,10 @@ def page(out: Path, older: Path = OLDER) -> str:
     for name, measure in MEASURES.items():
         path = out / f"{name}.json"
         if not path.is_file():
-            missing.append(name)
+            if measure.title in kept:
+                lines += ["", f"## {measure.title}", *kept[measure.title]]
+            else:
+                missing.append(name)
             continue
         record = json.loads(path.read_text())
         lines += [
@@ -505,7 +567,8 @@ def main() -> None:
             for name in names:
                 print(f"{name} ...", flush=True)
                 run_measure(name, args, tiny, args.out)
-    atomic_write_text(args.output, page(args.out))
+    current = args.output.read_text(encoding="utf-8") if args.output.is_file() else ""
+    atomic_write_text(args.output, page(args.out, current=current))
     print(f"wrote {args.output}")
 
 

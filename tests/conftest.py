@@ -4,6 +4,9 @@ session-end check that no process of the run survives."""
 
 from __future__ import annotations
 
+import contextlib
+import fcntl
+import json
 import os
 import sys
 import time
@@ -19,10 +22,13 @@ import pytest
 # torchvision's models import) each bring an LLVM, and loading triton after Mesa segfaults.
 # `import seannet` does this first in its own processes; the test session mixes both.
 import torch._dynamo  # noqa: F401  isort: skip
+import torch
 import trimesh
 
 from sgdata.usd.meshes import MeshData, ObjectGeometry, SceneGeometry
 from sgdata.world.scene import Dynamics, Opening, Placement, Room, SceneObject
+
+from .artefacts import changed_artefacts, run_folder, shared_artefact
 
 # The camera pose from which the tiny room's interesting objects are all in view.
 TINY_VIEW = (2.5, 0.5, np.pi / 2)  # x, y, theta: standing near the south wall, looking north
@@ -221,14 +227,18 @@ def mini_config_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 @pytest.fixture(scope="session")
-def mini_dataset(tmp_path_factory: pytest.TempPathFactory, mini_config_file: Path) -> Path:
-    """Root of the generated mini dataset (real USD, Parquet and PNG)."""
-    from sgdata.pipeline.config import load_config
-    from sgdata.pipeline.generate import generate_dataset
+def mini_dataset(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Root of the generated mini dataset (real USD, Parquet and PNG), built once per run."""
 
-    root = tmp_path_factory.mktemp("mini_dataset") / "data"
-    generate_dataset(load_config(mini_config_file), root, workers=2)
-    return root
+    def build(root: Path) -> None:
+        from sgdata.pipeline.config import load_config
+        from sgdata.pipeline.generate import generate_dataset
+
+        config_file = root.parent / "mini.toml"
+        config_file.write_text(MINI_TOML)
+        generate_dataset(load_config(config_file), root, workers=2)
+
+    return shared_artefact(tmp_path_factory, "mini_dataset", build)
 
 
 # The mini dataset with the optional channels on (depth and instance masks): the channel
@@ -239,14 +249,16 @@ CHANNELS_TOML = MINI_TOML + "[outputs]\ndepth = true\ninstances = true\n"
 @pytest.fixture(scope="session")
 def channels_dataset(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """Root of the mini dataset generated with ``[outputs] depth`` and ``instances`` on."""
-    from sgdata.pipeline.config import load_config
-    from sgdata.pipeline.generate import generate_dataset
 
-    config_file = tmp_path_factory.mktemp("channels_config") / "channels.toml"
-    config_file.write_text(CHANNELS_TOML)
-    root = tmp_path_factory.mktemp("channels_dataset") / "data"
-    generate_dataset(load_config(config_file), root, workers=2)
-    return root
+    def build(root: Path) -> None:
+        from sgdata.pipeline.config import load_config
+        from sgdata.pipeline.generate import generate_dataset
+
+        config_file = root.parent / "channels.toml"
+        config_file.write_text(CHANNELS_TOML)
+        generate_dataset(load_config(config_file), root, workers=2)
+
+    return shared_artefact(tmp_path_factory, "channels_dataset", build)
 
 
 # --------------------------------------------------------------------------- seannet runs
@@ -294,11 +306,13 @@ def tiny_seannet():  # noqa: ANN201  (seannet.training.config.TrainConfig)
 @pytest.fixture(scope="session")
 def localizer_run(tmp_path_factory: pytest.TempPathFactory, mini_dataset: Path) -> Path:
     """A run directory (best.pt) trained on the mini dataset; no eval file, so no epsilon."""
-    from seannet.training.train import train
 
-    run = tmp_path_factory.mktemp("localizer") / "run"
-    train(tiny_localizer_config(), mini_dataset, run)
-    return run
+    def build(run: Path) -> None:
+        from seannet.training.train import train
+
+        train(tiny_localizer_config(), mini_dataset, run)
+
+    return shared_artefact(tmp_path_factory, "localizer_run", build)
 
 
 def tiny_navigation() -> dict:
@@ -314,28 +328,35 @@ def navigation_run(
 ) -> SimpleNamespace:
     """A navigator trained in seconds, and ``seannet navigate`` of the tiny localizer with
     it on the mini dataset's test room (two workers, paper rule and --replan, strips)."""
-    from seannet.navigation.benchmark import run_navigation
-    from seannet.navigation.navigator import NavigatorConfig
-    from seannet.navigation.navigator_training import train_navigator
 
-    root = tmp_path_factory.mktemp("navigation")
-    config = NavigatorConfig(
-        image_size=64, hidden=16, epochs=1, batch_size=8, train_pairs=8, val_pairs=4
-    )
-    history = train_navigator(config, mini_dataset, root / "nav")
-    options = tiny_navigation()
-    results = run_navigation(
-        [localizer_run],
-        root / "nav",
-        mini_dataset,
-        workers=2,
-        out=root / "out",
-        strips=root / "strips",
-        **options,
-    )
+    def build(root: Path) -> None:
+        from seannet.navigation.benchmark import run_navigation
+        from seannet.navigation.navigator import NavigatorConfig
+        from seannet.navigation.navigator_training import train_navigator
+
+        config = NavigatorConfig(
+            image_size=64, hidden=16, epochs=1, batch_size=8, train_pairs=8, val_pairs=4
+        )
+        train_navigator(config, mini_dataset, root / "nav")
+        run_navigation(
+            [localizer_run],
+            root / "nav",
+            mini_dataset,
+            workers=2,
+            out=root / "out",
+            strips=root / "strips",
+            **tiny_navigation(),
+        )
+
+    from seannet.navigation.benchmark import results_path
+
+    root = shared_artefact(tmp_path_factory, "navigation_run", build)
+    written = results_path(root / "out", tiny_navigation()["config"].split)
     return SimpleNamespace(
-        navigator=root / "nav", out=root / "out", strips=root / "strips", history=history,
-        results=results, options=options,
+        navigator=root / "nav", out=root / "out", strips=root / "strips",
+        history=json.loads((root / "nav" / "history.json").read_text()),
+        results={**json.loads(written.read_text()), "written": str(written.with_suffix(".md"))},
+        options=tiny_navigation(),
     )  # fmt: skip
 
 
@@ -426,11 +447,73 @@ def procs() -> SimpleNamespace:
     )
 
 
-def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
+# --------------------------------------------------------------------------- xdist workers
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """Under xdist, each worker's torch (and the processes its tests start) gets its share of
+    the cores: torch's OpenMP threads spin while they wait, so two workers of two threads each
+    on two cores burn half their time without progress."""
+    workers = getattr(config, "workerinput", {}).get("workercount")
+    if workers:
+        share = str(max(1, (os.cpu_count() or 1) // int(workers)))
+        os.environ["OMP_NUM_THREADS"] = share
+        torch.set_num_threads(int(share))
+
+
+# --------------------------------------------------------------------------- a quiet machine
+# A test marked `quiet` times the machine (a budget's calibration against busy loops): under
+# xdist it runs while the other workers wait, so that the quiet side of its comparison is
+# quiet. Every other test holds a shared lock while it runs (set-up and teardown included); a
+# quiet one takes it exclusively. The gate keeps new shared holders out while a quiet test
+# waits, so it is not starved.
+
+
+@contextlib.contextmanager
+def _machine_share(item: pytest.Item) -> Iterator[None]:
+    if not os.environ.get("PYTEST_XDIST_WORKER"):
+        yield
+        return
+    folder = run_folder(item.config._tmp_path_factory)  # type: ignore[attr-defined]
+    quiet = item.get_closest_marker("quiet") is not None
+    with open(folder / "quiet.gate", "a") as gate, open(folder / "quiet.lock", "a") as lock:
+        fcntl.flock(gate, fcntl.LOCK_EX)
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX if quiet else fcntl.LOCK_SH)
+        finally:
+            if not quiet:
+                fcntl.flock(gate, fcntl.LOCK_UN)
+        try:
+            yield
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)
+            fcntl.flock(gate, fcntl.LOCK_UN)
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None) -> Iterator[None]:
+    with _machine_share(item):
+        return (yield)
+
+
+@pytest.fixture(scope="session", autouse=True)
+def shared_artefacts_stay_unchanged() -> Iterator[None]:
+    """Fail the run when a test changed a shared artefact (tests/artefacts.py) in place."""
+    yield
+    changed = changed_artefacts()
+    assert not changed, f"a test changed shared artefacts; copy one before changing it: {changed}"
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> Iterator[None]:
     """Fail the run when a process it started outlives it (a pool worker, a resource
-    tracker, a Ray process): `make test` must leave nothing behind."""
+    tracker, a Ray process): `make test` must leave nothing behind. Under xdist the controller
+    checks, once every other hook (xdist's, which stops the workers) has run."""
     from multiprocessing import resource_tracker
 
+    result = yield
+    if hasattr(session.config, "workerinput"):  # an xdist worker: its controller checks
+        return result
     # This process's own resource tracker ends with it by design (its pipe closes); stop it
     # now so that what remains is what would really outlive the run.
     resource_tracker._resource_tracker._stop()
@@ -441,3 +524,4 @@ def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
     if left:
         print("\nprocesses started by the test run are still alive:\n  " + "\n  ".join(left))
         session.exitstatus = pytest.ExitCode.TESTS_FAILED
+    return result

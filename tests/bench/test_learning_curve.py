@@ -13,13 +13,14 @@ from seannet.training.config import TrainConfig
 from ..bench_scripts import load_bench
 
 
+@pytest.mark.slow  # 6 tiny runs over two budgets, each evaluated on val and test
 def test_curve_scales_the_first_budget_and_writes_the_runs(
     tmp_path: Path, mini_dataset: Path, tiny_seannet: TrainConfig
 ) -> None:
     curve = load_bench("learning_curve")
     runs = tmp_path / "runs"
-    budgets = curve.parse_budgets("0.2:2,0.05:2,0.8:1")  # sorted: 0.05 first
-    assert [b for b, _ in budgets] == [0.05, 0.2, 0.8]
+    budgets = curve.parse_budgets("0.2:1,0.05:2")  # sorted: 0.05 first
+    assert [b for b, _ in budgets] == [0.05, 0.2]
     page = tmp_path / "docs" / "curve.md"
     page.parent.mkdir()
     written = []  # what `run --doc` writes after each budget's evaluation
@@ -32,18 +33,17 @@ def test_curve_scales_the_first_budget_and_writes_the_runs(
         mini_dataset, runs, budgets, ("seannet", "seannet+boxes"), preset=tiny_seannet,
         progress=write,
     )  # fmt: skip
-    assert written == [1, 2, 3]  # a point more each time
+    assert written == [1, 2]  # a point more each time
 
     points = curve.read_curve(runs)
     assert list(points) == ["seannet", "seannet+boxes"]
-    first, middle, last = points["seannet"]
-    assert (first["seeds"], middle["seeds"], last["seeds"]) == (2, 2, 1)
+    first, last = points["seannet"]
+    assert (first["seeds"], last["seeds"]) == (2, 1)
     # the first budget's calibrated batches, scaled by the budget: no second timing
-    assert middle["batches_per_epoch"] == max(1, round(first["batches_per_epoch"] * 4))
-    assert last["batches_per_epoch"] == max(1, round(first["batches_per_epoch"] * 16))
-    assert middle["lr"] == last["lr"] == first["lr"]  # chosen on val at the first budget
-    rows = json.loads((runs / "b0.8" / curve.CURVE).read_text())["runs"]
-    assert {Path(r["run"]).parent.parent.parent for r in rows} == {runs / "b0.8"}
+    assert last["batches_per_epoch"] == max(1, round(first["batches_per_epoch"] * 4))
+    assert last["lr"] == first["lr"]  # chosen on val at the first budget
+    rows = json.loads((runs / "b0.2" / curve.CURVE).read_text())["runs"]
+    assert {Path(r["run"]).parent.parent.parent for r in rows} == {runs / "b0.2"}
     # the boxes row is the same network's runs (its lr chosen on val with the boxes)
     assert {Path(r["run"]).parent.parent.name for r in rows} == {"seannet"}
 

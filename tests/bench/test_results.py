@@ -5,6 +5,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
+
 from seannet.evaluation.compare import compare_models
 from seannet.provenance import append_provenance
 from seannet.training.config import TrainConfig
@@ -12,6 +14,7 @@ from seannet.training.config import TrainConfig
 from ..bench_scripts import load_bench
 
 
+@pytest.mark.slow  # the headline, noise, kernel and full-map steps trained and evaluated for real
 def test_tables_are_the_runs_figures(
     tmp_path: Path, mini_dataset: Path, tiny_seannet: TrainConfig
 ) -> None:

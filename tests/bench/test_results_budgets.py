@@ -6,6 +6,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
+
 from seannet.provenance import append_provenance
 from seannet.training.config import TrainConfig
 
@@ -20,6 +22,7 @@ def _section(doc: str, title: str) -> str:
     return doc[start : end if end > 0 else None]
 
 
+@pytest.mark.slow  # three protocol steps, each two networks x two seeds x two lrs
 def test_sections_compare_like_for_like(
     tmp_path: Path, mini_dataset: Path, tiny_seannet: TrainConfig
 ) -> None:

@@ -79,3 +79,31 @@ def test_the_page_is_the_scripts_figures(tmp_path: Path, mini_dataset: Path) -> 
     runs[1]["views_per_s"] = 30.0
     (out / "generate.json").write_text(json.dumps(record))
     assert "| **2 workers / 1** | 3.00x (rounds 2.00x to 3.00x) |" in suite.page(out, older=older)
+
+
+def test_a_measure_run_alone_keeps_the_other_sections(tmp_path: Path) -> None:
+    suite = load_bench("suite")
+    out = tmp_path / "bench"
+    out.mkdir()
+    stamp = suite.machine_stamp()
+    runs = [
+        {"target": "test", "wall_s": 450.0, "tests": 3, "test_seconds": 800.0,
+         "outcomes": {"passed": 2, "skipped": 1}, "peak_disk_mb": 1500,
+         "slowest": [{"test": "tests.a::test_x", "seconds": 25.04, "outcome": "passed"}]},
+        {"target": "test-fast", "wall_s": 100.0, "tests": 2, "test_seconds": 150.0,
+         "outcomes": {"passed": 2}, "peak_disk_mb": 900, "slowest": []},
+    ]  # fmt: skip
+    record = {"measure": "tests", "stamp": stamp, "commands": [["x"]], "result": runs}
+    (out / "tests.json").write_text(json.dumps(record))
+    render = "## Rendering, one llvmpipe thread (`bench/render.py`)"
+    current = f"# Benchmarks\n\n{render}\n\n*Measured then.*\n\n| a | 1 |\n\n## Older figures\n"
+    doc = suite.page(out, older=tmp_path / "none.md", current=current)
+    # the render section, not re-run, stays as it was, stamp and table; the rest is listed
+    assert f"{render}\n\n*Measured then.*\n\n| a | 1 |\n\n## " in doc
+    assert "`bench/render.py`): `python bench/suite.py run OUT`" not in doc
+    assert "`python bench/suite.py run OUT --extras fuzz`" in doc
+    assert "| `make test` | 450 s (7.5 min) | 2 passed, 1 skipped | 800 s | 1,500 MB |" in doc
+    assert "| `make test-fast` | 100 s (1.7 min) | 2 passed | 150 s | 900 MB |" in doc
+    assert "| `tests.a::test_x` | 25.0 |" in doc
+    # written again from the page it wrote: the same page
+    assert suite.page(out, older=tmp_path / "none.md", current=doc) == doc

@@ -12,6 +12,8 @@ import sys
 from pathlib import Path
 from types import ModuleType
 
+import pytest
+
 from ..bench_scripts import BENCH, load_bench
 
 
@@ -57,6 +59,7 @@ def test_profile_books_the_whole_step_to_parts(mini_dataset: Path, tmp_path: Pat
     assert re.search(r"backward booked to a part: (9\d|100)\.\d %", out)
 
 
+@pytest.mark.slow  # times every network the protocol trains, in three bench processes
 def test_step_costs_are_the_budgets_calibration_and_branch_motion_trains_by_the_library_step(
     mini_dataset: Path, tmp_path: Path
 ) -> None:

@@ -1,23 +1,22 @@
-"""The sgdata command end to end, as a user runs it (real subprocesses)."""
+"""The sgdata command end to end, as a user runs it (the console script's entry point, in-process:
+tests/cli_runner.py; the installed script itself runs in the labeling server's and the kill -9
+tests)."""
 
 from __future__ import annotations
 
 import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
-SGDATA = [sys.executable, "-m", "sgdata_cli.sgdata_app"]
+from ..cli_runner import Done, run_cli
 
 
-def run(*args: str) -> subprocess.CompletedProcess[str]:
-    env = {**os.environ, "COLUMNS": "120"}
-    return subprocess.run([*SGDATA, *args], capture_output=True, text=True, env=env, timeout=300)
+def run(*args: str) -> Done:
+    return run_cli("sgdata", *args)
 
 
-def assert_one_line_error(result: subprocess.CompletedProcess[str], needle: str) -> None:
+def assert_one_line_error(result: Done, needle: str) -> None:
     assert result.returncode == 2, result.stderr
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1, result.stderr

@@ -1,20 +1,17 @@
-"""sgdata validate / sgdata report from the command line (real subprocesses)."""
+"""sgdata validate / sgdata report from the command line (the console script's entry point,
+in-process: tests/cli_runner.py)."""
 
 from __future__ import annotations
 
 import json
-import os
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
-SGDATA = [sys.executable, "-m", "sgdata_cli.sgdata_app"]
+from ..cli_runner import Done, run_cli
 
 
-def run(*args: str) -> subprocess.CompletedProcess[str]:
-    env = {**os.environ, "COLUMNS": "120"}
-    return subprocess.run([*SGDATA, *args], capture_output=True, text=True, env=env, timeout=300)
+def run(*args: str) -> Done:
+    return run_cli("sgdata", *args)
 
 
 def test_validate_clean_and_damaged(mini_dataset: Path, tmp_path: Path) -> None:

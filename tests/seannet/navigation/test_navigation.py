@@ -41,6 +41,8 @@ from seannet.navigation.tables import case_rates, read_results
 from seannet.seeds import episode_seed
 from sgdata.seeds import rng_for
 
+from ...cli_runner import run_cli
+
 EPS = 0.9
 GOAL = (4, 2, 0)
 
@@ -202,10 +204,7 @@ def test_navigate_end_to_end_writes_table_two(
 
 
 def test_navigate_wants_a_navigator_or_the_oracle(localizer_run: Path, mini_dataset: Path) -> None:
-    command = [sys.executable, "-m", "sgdata_cli.seannet_app", "navigate", str(localizer_run)]
-    result = subprocess.run(
-        [*command, "--data", str(mini_dataset)], capture_output=True, text=True, timeout=300
-    )
+    result = run_cli("seannet", "navigate", localizer_run, "--data", mini_dataset)
     assert result.returncode != 0 and "Traceback" not in result.stderr
     (line,) = result.stderr.strip().splitlines()
     assert "--navigator RUN" in line and "--oracle" in line

@@ -3,10 +3,7 @@
 from __future__ import annotations
 
 import json
-import os
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -20,6 +17,8 @@ from seannet.seeds import init_seed
 from seannet.training.config import TrainConfig
 from seannet.training.runs import build_for_dataset, load_checkpoint
 from seannet.training.train import train
+
+from ...cli_runner import run_cli
 
 # Small enough for a CPU test: ResNet-18 at 64 px, 12 triplets an epoch, no loader workers.
 FAST = TrainConfig().replace(
@@ -97,22 +96,8 @@ def test_other_dataset_and_existing_run_are_refused(tmp_path: Path, mini_dataset
 def test_cli_refuses_a_bad_pretrained_file(tmp_path: Path, mini_dataset: Path) -> None:
     bad = tmp_path / "weights.pth"
     bad.write_bytes(b"not a state dict")
-    cli = [sys.executable, "-m", "sgdata_cli.seannet_app"]
-    result = subprocess.run(
-        [
-            *cli,
-            "train",
-            "--data",
-            str(mini_dataset),
-            "--out",
-            str(tmp_path / "r"),
-            "--pretrained",
-            str(bad),
-        ],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        env={**os.environ, "COLUMNS": "120"},
+    result = run_cli(
+        "seannet", "train", "--data", mini_dataset, "--out", tmp_path / "r", "--pretrained", bad
     )
     assert result.returncode == 2, result.stderr
     lines = result.stderr.strip().splitlines()

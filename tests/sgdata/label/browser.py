@@ -1,14 +1,20 @@
-"""Driving the labeling page in Debian's headless Chromium: launch, draw, wait for a save."""
+"""Driving the labeling page in Debian's headless Chromium: serve, draw, wait for a save.
+
+The page's server is the app ``sgdata label`` builds (:func:`sgdata.label.server.create_app`)
+under uvicorn, in a thread of the test's own process: these tests are about the page, and
+``server_process.py``'s subprocess (the console script's start-up) is tested on its own."""
 
 from __future__ import annotations
 
 import contextlib
+import threading
+import time
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
-from .server_process import label_server
+from .server_process import free_port
 
 CHROMIUM = "/usr/bin/chromium"
 ARGS = [
@@ -20,29 +26,68 @@ ARGS = [
     "--disable-sync",
     "--no-first-run",
 ]
-needs_chromium = pytest.mark.skipif(not Path(CHROMIUM).exists(), reason="needs Debian's chromium")
+# a browser test's marks: `browser`, and skipped (with its reason) where chromium is missing
+needs_chromium = [
+    pytest.mark.browser,
+    pytest.mark.skipif(not Path(CHROMIUM).exists(), reason="needs Debian's chromium"),
+]
+
+
+@contextlib.contextmanager
+def fresh_page(chromium, viewport: tuple[int, int] = (1400, 800)) -> Iterator:  # noqa: ANN001
+    """A page in a fresh context of the session's browser (no cookies or storage shared)."""
+    context = chromium.new_context(viewport={"width": viewport[0], "height": viewport[1]})
+    try:
+        yield context.new_page()
+    finally:
+        context.close()
+
+
+@contextlib.contextmanager
+def app_server(photos: Path, out: Path) -> Iterator[str]:
+    """The labeling app for ``photos`` and ``out`` served on a free loopback port by uvicorn
+    in a thread, as ``sgdata label`` serves it; yields the base URL, stops it on exit."""
+    import uvicorn
+
+    from sgdata.label.server import LOOPBACK, create_app
+
+    app = create_app(photos, out, allowed_hosts=LOOPBACK)
+    port = free_port()
+    server = uvicorn.Server(
+        uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning", lifespan="on")
+    )
+    thread = threading.Thread(target=server.run, name="label-server", daemon=True)
+    thread.start()
+    try:
+        deadline = time.monotonic() + 30
+        while not server.started:
+            if not thread.is_alive() or time.monotonic() > deadline:
+                raise RuntimeError("the labeling app did not start in 30 s")
+            time.sleep(0.02)
+        yield f"http://127.0.0.1:{port}"
+    finally:
+        server.should_exit = True
+        thread.join(timeout=10)
 
 
 @contextlib.contextmanager
 def labeling_page(
-    photos: Path, out: Path, *extra: str, viewport: tuple[int, int] = (1400, 800), init: str = ""
+    chromium,  # noqa: ANN001  (playwright's Browser)
+    photos: Path,
+    out: Path,
+    *,
+    viewport: tuple[int, int] = (1400, 800),
+    init: str = "",
 ) -> Iterator:
-    """A page on a fresh ``sgdata label`` server, loaded; ``init`` runs before the page's JS."""
-    from playwright.sync_api import sync_playwright
-
-    with label_server(photos, out, *extra) as (url, _), sync_playwright() as pw:
-        browser = pw.chromium.launch(executable_path=CHROMIUM, args=ARGS)
-        try:
-            page = browser.new_page(viewport={"width": viewport[0], "height": viewport[1]})
-            page.failed = []  # URLs answered >= 400 (a missing favicon shows up here)
-            page.on("response", lambda r: r.status >= 400 and page.failed.append(r.url))
-            if init:
-                page.add_init_script(init)
-            page.goto(url + "/")
-            page.wait_for_selector('#status[data-state="loaded"]')
-            yield page
-        finally:
-            browser.close()
+    """A page on a fresh labeling server, loaded; ``init`` runs before the page's JS."""
+    with app_server(photos, out) as url, fresh_page(chromium, viewport) as page:
+        page.failed = []  # URLs answered >= 400 (a missing favicon shows up here)
+        page.on("response", lambda r: r.status >= 400 and page.failed.append(r.url))
+        if init:
+            page.add_init_script(init)
+        page.goto(url + "/")
+        page.wait_for_selector('#status[data-state="loaded"]')
+        yield page
 
 
 def drag(page, box: list[int], photo_size: tuple[int, int]) -> None:

@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
 import pytest
 from PIL import Image
+
+from .browser import ARGS, CHROMIUM
 
 
 def make_photo(path: Path, width: int = 320, height: int = 240, seed: int = 0) -> Path:
@@ -31,3 +34,14 @@ def photos_dir(tmp_path: Path) -> Path:
     (root / "notes.txt").write_text("not a photo\n")
     (root / "broken.png").write_bytes(b"\x89PNG not really")
     return root
+
+
+@pytest.fixture(scope="session")
+def chromium() -> Iterator:
+    """One headless Chromium for the whole test session; each test opens its own context."""
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as pw:
+        browser = pw.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+        yield browser
+        browser.close()

@@ -3,97 +3,82 @@
 from __future__ import annotations
 
 import os
-import subprocess
 from pathlib import Path
 
 import pyarrow.parquet as pq
 
 from sgdata.validate import validate_dataset
 
-from .browser import ARGS, CHROMIUM, needs_chromium
+from ...cli_runner import run_cli
+from .browser import app_server, fresh_page, needs_chromium
 from .browser import drag as _drag
 from .browser import saved as _saved
 from .conftest import make_photo
-from .server_process import SGDATA, label_server
 
 pytestmark = needs_chromium
 
 
-def test_label_two_photos_in_the_browser_and_export(tmp_path: Path) -> None:
-    from playwright.sync_api import sync_playwright
-
+def test_label_two_photos_in_the_browser_and_export(chromium, tmp_path: Path) -> None:  # noqa: ANN001
     photos, out = tmp_path / "photos", tmp_path / "ds"
     photos.mkdir()
     make_photo(photos / "p1.png", 320, 240, seed=1)
     make_photo(photos / "p2.png", 320, 240, seed=2)
     (photos / "readme.txt").write_text("skip me")
     size = (320, 240)
-    with label_server(photos, out) as (url, _), sync_playwright() as pw:
-        browser = pw.chromium.launch(executable_path=CHROMIUM, args=ARGS)
-        try:
-            page = browser.new_page(viewport={"width": 1400, "height": 800})
-            page.goto(url + "/")
-            page.wait_for_selector("#photos li")
-            assert "readme.txt" in page.locator("#skipped").text_content()
-            # the list renders before the first photo has loaded: wait for the photo itself
-            page.wait_for_selector('body[data-photo="p1.png"]')
-            # photo 1: room, a table and a mug standing on it
-            page.fill("#room-id", "kitchen_real")
-            page.locator("#room-id").press("Enter")
-            page.select_option("#room-type", "kitchen")
-            _saved(page)
-            _drag(page, [40, 100, 280, 230], size)
-            page.keyboard.type("diningt")
-            page.wait_for_selector("#class-suggest li.active")
-            assert page.locator("#class-suggest li.active").inner_text() == "DiningTable"
-            page.keyboard.press("Enter")
-            _drag(page, [120, 60, 170, 105], size)
-            page.keyboard.type("mu")
-            page.keyboard.press("Enter")
-            rel = page.locator('#arrows .rel[data-src="1"][data-dst="0"]')
-            rel.wait_for()
-            assert rel.get_attribute("data-type") == "on"
-            assert rel.get_attribute("data-status") == "pending"
-            rel.locator("text.hit").dispatch_event("pointerdown")
-            page.keyboard.press("Enter")  # accept "mug on table"
-            page.wait_for_selector('#arrows .rel[data-src="1"][data-status="accepted"]')
-            _saved(page)
-            if os.environ.get("SGDATA_LABEL_SCREENSHOT"):
-                page.screenshot(path=os.environ["SGDATA_LABEL_SCREENSHOT"])
-            # photo 2: a book inside a shelving unit (not a container: proposed "on"), retyped
-            # to "in" with the I key
-            page.keyboard.press("ArrowRight")
-            page.wait_for_selector('body[data-photo="p2.png"]')
-            page.fill("#room-id", "kitchen_real")
-            page.locator("#room-id").press("Enter")
-            page.select_option("#room-type", "kitchen")
-            _drag(page, [20, 20, 300, 220], size)
-            page.keyboard.type("ShelvingU")
-            page.keyboard.press("Enter")
-            _drag(page, [100, 120, 140, 160], size)
-            page.keyboard.type("Book")
-            page.keyboard.press("Enter")
-            page.wait_for_selector(
-                '#arrows .rel[data-src="3"][data-type="on"][data-status="pending"]'
-            )
-            page.locator("#stage").focus()
-            page.keyboard.press("Tab")
-            page.keyboard.press("i")
-            page.wait_for_selector('#arrows .rel[data-type="in"][data-status="accepted"]')
-            _saved(page)
-            # back to photo 1: its boxes and accepted relation come back from the server
-            page.keyboard.press("ArrowLeft")
-            page.wait_for_selector('body[data-photo="p1.png"]')
-            page.wait_for_selector('#arrows .rel[data-type="on"][data-status="accepted"]')
-            assert page.locator("#boxes .box").count() == 2
-        finally:
-            browser.close()
-    done = subprocess.run(
-        [SGDATA, "label", str(photos), "--out", str(out), "--export"],
-        capture_output=True,
-        text=True,
-        timeout=120,
-    )
+    with app_server(photos, out) as url, fresh_page(chromium) as page:
+        page.goto(url + "/")
+        page.wait_for_selector("#photos li")
+        assert "readme.txt" in page.locator("#skipped").text_content()
+        # the list renders before the first photo has loaded: wait for the photo itself
+        page.wait_for_selector('body[data-photo="p1.png"]')
+        # photo 1: room, a table and a mug standing on it
+        page.fill("#room-id", "kitchen_real")
+        page.locator("#room-id").press("Enter")
+        page.select_option("#room-type", "kitchen")
+        _saved(page)
+        _drag(page, [40, 100, 280, 230], size)
+        page.keyboard.type("diningt")
+        page.wait_for_selector("#class-suggest li.active")
+        assert page.locator("#class-suggest li.active").inner_text() == "DiningTable"
+        page.keyboard.press("Enter")
+        _drag(page, [120, 60, 170, 105], size)
+        page.keyboard.type("mu")
+        page.keyboard.press("Enter")
+        rel = page.locator('#arrows .rel[data-src="1"][data-dst="0"]')
+        rel.wait_for()
+        assert rel.get_attribute("data-type") == "on"
+        assert rel.get_attribute("data-status") == "pending"
+        rel.locator("text.hit").dispatch_event("pointerdown")
+        page.keyboard.press("Enter")  # accept "mug on table"
+        page.wait_for_selector('#arrows .rel[data-src="1"][data-status="accepted"]')
+        _saved(page)
+        if os.environ.get("SGDATA_LABEL_SCREENSHOT"):
+            page.screenshot(path=os.environ["SGDATA_LABEL_SCREENSHOT"])
+        # photo 2: a book inside a shelving unit (not a container: proposed "on"), retyped
+        # to "in" with the I key
+        page.keyboard.press("ArrowRight")
+        page.wait_for_selector('body[data-photo="p2.png"]')
+        page.fill("#room-id", "kitchen_real")
+        page.locator("#room-id").press("Enter")
+        page.select_option("#room-type", "kitchen")
+        _drag(page, [20, 20, 300, 220], size)
+        page.keyboard.type("ShelvingU")
+        page.keyboard.press("Enter")
+        _drag(page, [100, 120, 140, 160], size)
+        page.keyboard.type("Book")
+        page.keyboard.press("Enter")
+        page.wait_for_selector('#arrows .rel[data-src="3"][data-type="on"][data-status="pending"]')
+        page.locator("#stage").focus()
+        page.keyboard.press("Tab")
+        page.keyboard.press("i")
+        page.wait_for_selector('#arrows .rel[data-type="in"][data-status="accepted"]')
+        _saved(page)
+        # back to photo 1: its boxes and accepted relation come back from the server
+        page.keyboard.press("ArrowLeft")
+        page.wait_for_selector('body[data-photo="p1.png"]')
+        page.wait_for_selector('#arrows .rel[data-type="on"][data-status="accepted"]')
+        assert page.locator("#boxes .box").count() == 2
+    done = run_cli("sgdata", "label", photos, "--out", out, "--export")
     assert done.returncode == 0, done.stderr
     assert validate_dataset(out).ok
     rows = {

@@ -6,8 +6,10 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
 from PIL import Image, ImageDraw
 
+from ...cli_runner import run_cli
 from .browser import box_with_class, click_at, drag, labeling_page, needs_chromium, saved, set_room
 from .conftest import make_photo
 
@@ -42,9 +44,9 @@ def _selected(page) -> str | None:
     return found.get_attribute("data-id") if found.count() else None
 
 
-def test_fast_undo_after_a_draw_is_saved_not_refused(tmp_path: Path) -> None:
+def test_fast_undo_after_a_draw_is_saved_not_refused(chromium, tmp_path: Path) -> None:
     photos, out = _photos(tmp_path, "p1.png"), tmp_path / "ds"
-    with labeling_page(photos, out, init=SLOW_SAVES) as page:
+    with labeling_page(chromium, photos, out, init=SLOW_SAVES) as page:
         set_room(page)
         drag(page, [40, 40, 200, 200], SIZE)
         page.keyboard.press("Escape")  # leave the class field
@@ -62,14 +64,14 @@ def test_fast_undo_after_a_draw_is_saved_not_refused(tmp_path: Path) -> None:
         assert "1 boxes" in page.locator('#photos li[data-name="p1.png"]').inner_text()
 
 
-def test_text_is_readable_on_a_phone_sized_photo(tmp_path: Path) -> None:
+def test_text_is_readable_on_a_phone_sized_photo(chromium, tmp_path: Path) -> None:
     photos, out = tmp_path / "photos", tmp_path / "ds"
     photos.mkdir()
     image = Image.new("RGB", (6000, 4000), (180, 170, 160))
     ImageDraw.Draw(image).rectangle([500, 2500, 5500, 3900], fill=(120, 80, 40))
     image.save(photos / "phone.jpg", quality=80)
     size = (6000, 4000)
-    with labeling_page(photos, out) as page:
+    with labeling_page(chromium, photos, out) as page:
         box_with_class(page, [500, 2500, 5500, 3900], size, "DiningT")
         box_with_class(page, [2000, 1500, 2600, 2700], size, "Mug")
         page.wait_for_selector("#arrows .rel text")
@@ -80,9 +82,9 @@ def test_text_is_readable_on_a_phone_sized_photo(tmp_path: Path) -> None:
         assert len(heights) == 3 and min(heights) >= 12, heights  # screen pixels
 
 
-def test_a_box_under_a_later_bigger_box_can_be_selected(tmp_path: Path) -> None:
+def test_a_box_under_a_later_bigger_box_can_be_selected(chromium, tmp_path: Path) -> None:
     photos, out = _photos(tmp_path, "p1.png"), tmp_path / "ds"
-    with labeling_page(photos, out) as page:
+    with labeling_page(chromium, photos, out) as page:
         box_with_class(page, [100, 100, 150, 150], SIZE, "Mug")  # id 0
         box_with_class(page, [50, 50, 250, 230], SIZE, "DiningT")  # id 1, drawn over it
         page.wait_for_selector("#arrows .rel")  # an arrow now runs through the mug's centre
@@ -99,9 +101,9 @@ def test_a_box_under_a_later_bigger_box_can_be_selected(tmp_path: Path) -> None:
         assert _stored(out, "p1.png")["objects"][0]["box"] == [100, 100, 150, 150]  # not moved
 
 
-def test_carry_over_asks_before_replacing_labels(tmp_path: Path) -> None:
+def test_carry_over_asks_before_replacing_labels(chromium, tmp_path: Path) -> None:
     photos, out = _photos(tmp_path, "p1.png", "p2.png"), tmp_path / "ds"
-    with labeling_page(photos, out) as page:
+    with labeling_page(chromium, photos, out) as page:
         set_room(page)
         box_with_class(page, [10, 10, 100, 100], SIZE, "Chair")
         page.keyboard.press("ArrowRight")
@@ -121,9 +123,9 @@ def test_carry_over_asks_before_replacing_labels(tmp_path: Path) -> None:
         assert [o["class_name"] for o in _stored(out, "p2.png")["objects"]] == ["Chair"]
 
 
-def test_unknown_class_is_said_with_the_closest_names(tmp_path: Path) -> None:
+def test_unknown_class_is_said_with_the_closest_names(chromium, tmp_path: Path) -> None:
     photos, out = _photos(tmp_path, "p1.png"), tmp_path / "ds"
-    with labeling_page(photos, out) as page:
+    with labeling_page(chromium, photos, out) as page:
         drag(page, [40, 40, 200, 200], SIZE)
         page.keyboard.type("Mugg")
         page.keyboard.press("Enter")
@@ -133,9 +135,9 @@ def test_unknown_class_is_said_with_the_closest_names(tmp_path: Path) -> None:
         assert "box 0 has no class" in page.locator("#problems").inner_text()
 
 
-def test_ready_marker_counts_photos_ready_to_export(tmp_path: Path) -> None:
+def test_ready_marker_counts_photos_ready_to_export(chromium, tmp_path: Path) -> None:
     photos, out = _photos(tmp_path, "p1.png", "p2.png"), tmp_path / "ds"
-    with labeling_page(photos, out) as page:
+    with labeling_page(chromium, photos, out) as page:
         assert page.locator("#ready-count").inner_text() == "0/2 ready to export"
         set_room(page)
         box_with_class(page, [40, 100, 280, 230], SIZE, "DiningT")
@@ -158,7 +160,7 @@ def test_ready_marker_counts_photos_ready_to_export(tmp_path: Path) -> None:
         assert page.failed == []  # no 404 (favicon) nor any refused request
 
 
-def test_cup_on_a_saucer_photo_proposes_on(tmp_path: Path) -> None:
+def test_cup_on_a_saucer_photo_proposes_on(chromium, tmp_path: Path) -> None:
     """scikit-image's coffee photo (CC0), labelled as a person would; the docs' screenshot."""
     import os
     import shutil
@@ -169,7 +171,7 @@ def test_cup_on_a_saucer_photo_proposes_on(tmp_path: Path) -> None:
     photos.mkdir()
     shutil.copy(Path(skimage.data.__file__).parent / "coffee.png", photos / "coffee.png")
     size = (600, 400)
-    with labeling_page(photos, out, viewport=(1280, 560)) as page:
+    with labeling_page(chromium, photos, out, viewport=(1280, 560)) as page:
         set_room(page, "cafe_1", "kitchen")
         box_with_class(page, [76, 70, 480, 388], size, "Plate")  # the saucer
         box_with_class(page, [172, 18, 410, 308], size, "Cup")
@@ -185,15 +187,12 @@ def test_cup_on_a_saucer_photo_proposes_on(tmp_path: Path) -> None:
             page.screenshot(path=os.environ["SGDATA_LABEL_SCREENSHOT"])
 
 
-def test_a_day_of_work_twenty_phone_photos_of_one_room(tmp_path: Path) -> None:
+@pytest.mark.slow  # twenty 12-megapixel photos through the page and the export
+def test_a_day_of_work_twenty_phone_photos_of_one_room(chromium, tmp_path: Path) -> None:
     """20 phone-sized photos of one room without a reload: carry over, move, fast undo/redo."""
-    import subprocess
-
     import pyarrow.parquet as pq
 
     from sgdata.validate import validate_dataset
-
-    from .server_process import SGDATA
 
     photos, out = tmp_path / "photos", tmp_path / "ds"
     photos.mkdir()
@@ -202,7 +201,7 @@ def test_a_day_of_work_twenty_phone_photos_of_one_room(tmp_path: Path) -> None:
         image = Image.new("RGB", size, (170 + k, 160, 150))
         ImageDraw.Draw(image).rectangle([500, 1500, 3500, 2900], fill=(110, 70, 40))
         image.save(photos / f"IMG_{k:04d}.jpg", quality=85)
-    with labeling_page(photos, out, init=SLOW_SAVES) as page:
+    with labeling_page(chromium, photos, out, init=SLOW_SAVES) as page:
         set_room(page, "kitchen_home", "kitchen")
         box_with_class(page, [500, 1500, 3500, 2900], size, "DiningT")
         box_with_class(page, [1500, 1000, 2000, 1600], size, "Mug")
@@ -228,12 +227,7 @@ def test_a_day_of_work_twenty_phone_photos_of_one_room(tmp_path: Path) -> None:
         page.wait_for_timeout(1500)
         saved(page)
         assert page.locator("#ready-count").inner_text() == "20/20 ready to export"
-    done = subprocess.run(
-        [SGDATA, "label", str(photos), "--out", str(out), "--export"],
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
+    done = run_cli("sgdata", "label", photos, "--out", out, "--export")
     assert done.returncode == 0, done.stderr
     assert "undecided" not in done.stdout
     report = validate_dataset(out)
@@ -249,13 +243,13 @@ def test_a_day_of_work_twenty_phone_photos_of_one_room(tmp_path: Path) -> None:
         assert [(r["src"], r["dst"], r["type"]) for r in row["relations"]] == [(1, 0, 0)]
 
 
-def test_undecodable_photo_is_shown_with_its_reason(tmp_path: Path) -> None:
+def test_undecodable_photo_is_shown_with_its_reason(chromium, tmp_path: Path) -> None:
     photos, out = _photos(tmp_path, "p1.png"), tmp_path / "ds"
     make_photo(photos / "whole.jpg", *SIZE, seed=5)
     data = (photos / "whole.jpg").read_bytes()
     (photos / "cut.jpg").write_bytes(data[: len(data) * 2 // 3])
     (photos / "whole.jpg").unlink()
-    with labeling_page(photos, out) as page:
+    with labeling_page(chromium, photos, out) as page:
         assert page.locator("#skipped-box").get_attribute("open") is not None  # shown, not folded
         assert page.locator("#skipped-box summary").inner_text() == "1 skipped file(s)"
         text = page.locator("#skipped").inner_text()

@@ -5,7 +5,6 @@ the boxes back, YOLO labels are the stored boxes; bad input is one line and writ
 from __future__ import annotations
 
 import json
-import subprocess
 import sys
 from collections import Counter
 from pathlib import Path
@@ -18,6 +17,8 @@ from sgdata.dataset.channels import decode_channel
 from sgdata.label.coco_export import export_coco
 from sgdata.label.importers import import_labels
 from sgdata.label.yolo_export import export_yolo
+
+from ...cli_runner import Done, run_cli
 
 pytest.importorskip("pycocotools")
 CLI = [sys.executable, "-m", "sgdata_cli.sgdata_app", "export"]
@@ -86,8 +87,7 @@ def test_import_coco_of_the_export_gives_the_boxes_back(
     assert back == _boxes(channels_dataset, "val")
     # a real dataset has no masks: --masks says so in one line and writes nothing
     out = tmp_path / "masks"
-    cli = [*CLI, "coco", str(tmp_path / "real"), "-o", str(out), "--masks"]
-    run = subprocess.run(cli, capture_output=True, text=True, timeout=120)
+    run = run_cli("sgdata", "export", "coco", tmp_path / "real", "-o", out, "--masks")
     assert run.returncode != 0 and "real" in run.stderr and "no instance masks" in run.stderr
     assert len(run.stderr.strip().splitlines()) == 1 and not out.exists()
 
@@ -117,8 +117,8 @@ def test_yolo_labels_are_the_stored_boxes(channels_dataset: Path, tmp_path: Path
 def test_bad_exports_are_one_line_and_write_nothing(
     channels_dataset: Path, mini_dataset: Path, tmp_path: Path
 ) -> None:
-    def run(*args: str) -> subprocess.CompletedProcess:
-        return subprocess.run([*CLI, *args], capture_output=True, text=True, timeout=120)
+    def run(*args: str) -> Done:
+        return run_cli("sgdata", "export", *args)
 
     out = tmp_path / "out"
     done = run("coco", str(mini_dataset), "-o", str(out), "--masks")  # mini: no masks

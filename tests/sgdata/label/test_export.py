@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import os
-import subprocess
 from pathlib import Path
 
 import pyarrow.parquet as pq
@@ -18,8 +16,8 @@ from sgdata.label.server import create_app
 from sgdata.label.store import LabelStore
 from sgdata.validate import validate_dataset
 
+from ...cli_runner import run_cli
 from .conftest import make_photo
-from .server_process import SGDATA
 
 
 def _labels(**fields) -> PhotoLabels:
@@ -135,13 +133,7 @@ def test_undecided_proposals_are_named_by_photo(photos_dir: Path, tmp_path: Path
     store.save("a.png", _labels(objects=[table, mug]))
     store.save("c.jpg", _labels(objects=[{"id": 2, "class_name": "Chair", "box": [1, 1, 9, 9]}]))
     assert export_dataset(photos_dir, out).pending == {"a.png": 1}
-    done = subprocess.run(
-        [SGDATA, "label", str(photos_dir), "--out", str(out), "--export"],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        env={**os.environ, "COLUMNS": "300"},
-    )
+    done = run_cli("sgdata", "label", photos_dir, "--out", out, "--export", columns=300)
     assert done.returncode == 0, done.stderr
     assert "1 undecided proposal(s) stored as disjoint: a.png (1)" in done.stdout
 

@@ -3,9 +3,6 @@
 from __future__ import annotations
 
 import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pyarrow.parquet as pq
@@ -19,6 +16,7 @@ from sgdata.label.models import PhotoLabels
 from sgdata.label.store import LabelStore
 from sgdata.validate import validate_dataset
 
+from ...cli_runner import run_cli
 from .conftest import make_photo
 
 ON, IN, PROXIMITY, DISJOINT = range(4)
@@ -233,53 +231,20 @@ def test_round_trip_keeps_boxes_and_relations(tmp_path: Path) -> None:
 
 def test_cli_export_then_import(tmp_path: Path) -> None:
     first = _labeled_dataset(tmp_path)
-    cli = [sys.executable, "-m", "sgdata_cli.sgdata_app"]
-    env = {**os.environ, "COLUMNS": "200"}
     out = tmp_path / "ls.json"
-    exported = subprocess.run(
-        [
-            *cli,
-            "export",
-            "labelstudio",
-            str(first),
-            "-o",
-            str(out),
-            "--images",
-            str(tmp_path / "img"),
-        ],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        env=env,
+    exported = run_cli(
+        "sgdata", "export", "labelstudio", first, "-o", out, "--images", tmp_path / "img"
     )
     assert exported.returncode == 0, exported.stderr
     assert "wrote 6 task(s), 10 box(es) and 3 relation(s)" in exported.stdout
-    imported = subprocess.run(
-        [
-            *cli,
-            "import",
-            "labelstudio",
-            str(out),
-            "--images",
-            str(tmp_path / "img"),
-            "--out",
-            str(tmp_path / "again"),
-        ],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        env=env,
-    )
+    imported = run_cli(
+        "sgdata", "import", "labelstudio", out, "--images", tmp_path / "img",
+        "--out", tmp_path / "again",
+    )  # fmt: skip
     assert imported.returncode == 0, imported.stderr
     assert "imported 10 box(es) and 3 relation(s) of 6 photo(s)" in imported.stdout
     assert _content(tmp_path / "again") == _content(first)
-    bad = subprocess.run(
-        [*cli, "export", "bogus", str(first), "-o", str(out)],
-        capture_output=True,
-        text=True,
-        timeout=120,
-        env=env,
-    )
+    bad = run_cli("sgdata", "export", "bogus", first, "-o", out)
     assert bad.returncode == 2 and "expected one of coco, labelstudio, yolo" in bad.stderr
 
 

@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import json
 import signal
-import subprocess
 from pathlib import Path
 
 import httpx
 
-from .server_process import SGDATA, label_server
+from ...cli_runner import run_cli
+from .server_process import label_server
 
 LABELS = {
     "room_id": "k1",
@@ -37,23 +37,14 @@ def test_kill_9_after_a_save_loses_nothing(photos_dir: Path, tmp_path: Path) -> 
 
 
 def test_cli_reports_bad_inputs_in_one_line(tmp_path: Path) -> None:
-    done = subprocess.run(
-        [SGDATA, "label", str(tmp_path / "nowhere"), "--out", str(tmp_path / "ds"), "--export"],
-        capture_output=True,
-        text=True,
-        timeout=60,
-    )
+    done = run_cli("sgdata", "label", tmp_path / "nowhere", "--out", tmp_path / "ds", "--export")
     assert done.returncode == 2
     assert done.stderr.count("\n") == 1 and "does not exist" in done.stderr
     bad = tmp_path / "map.toml"
     bad.write_text('mug = "Unicorn"\n')
     (tmp_path / "photos").mkdir()
-    done = subprocess.run(
-        [SGDATA, "label", str(tmp_path / "photos"), "--out", str(tmp_path / "ds")]
-        + ["--classes", str(bad)],
-        capture_output=True,
-        text=True,
-        timeout=60,
+    done = run_cli(
+        "sgdata", "label", tmp_path / "photos", "--out", tmp_path / "ds", "--classes", bad
     )
     assert done.returncode == 2 and "Traceback" not in done.stderr
     assert "not a catalog class" in done.stderr

@@ -15,6 +15,8 @@ import pyarrow.parquet as pq
 from sgdata.pipeline.config import load_config
 from tests.asset_meshes import write_demo_assets
 
+from ...cli_runner import run_cli
+
 SGDATA = [sys.executable, "-m", "sgdata_cli.sgdata_app"]
 
 CONFIG = """\
@@ -93,14 +95,14 @@ def test_generate_with_mesh_classes_end_to_end(tmp_path: Path) -> None:
     assert seen_on_table > 0  # things rest on the mesh table's measured top
 
     # relations re-computable from the stored boxes and supports (every pair agrees)
-    checked = run("validate", str(one), "--sources", str(project))
+    checked = run_cli("sgdata", "validate", str(one), "--sources", str(project))
     assert checked.returncode == 0, checked.stdout + checked.stderr
     assert "sources.unchanged" in checked.stdout
 
     # a view of a layout, checked and annotated with the config's catalog (its mesh classes)
     for layout in ("0", "1"):
-        view = run(
-            "render", str(one / "scenes" / "kitchen_000"), "--layout", layout,
+        view = run_cli(
+            "sgdata", "render", str(one / "scenes" / "kitchen_000"), "--layout", layout,
             "--config", str(config), "-o", str(tmp_path / f"view_{layout}.png"),
         )  # fmt: skip
         assert view.returncode == 0, view.stderr
@@ -108,7 +110,7 @@ def test_generate_with_mesh_classes_end_to_end(tmp_path: Path) -> None:
 
     with open(project / "meshes/plate.stl", "ab") as handle:
         handle.write(b"\n")
-    changed = run("validate", str(one), "--quick", "--sources", str(project))
+    changed = run_cli("sgdata", "validate", str(one), "--quick", "--sources", str(project))
     assert changed.returncode != 0
     assert "meshes/plate.stl" in changed.stdout and "changed since" in changed.stdout
 

@@ -18,6 +18,7 @@ from sgdata.pipeline.config import GenerateConfig, RoomsConfig, config_to_dict, 
 from sgdata.pipeline.generate import LEDGER, plan_rooms
 from sgdata.pipeline.user_rooms import resolve_user_rooms
 
+from ...cli_runner import run_cli
 from ..usd.user_stages import write_user_room
 
 SGDATA = [sys.executable, "-m", "sgdata_cli.sgdata_app"]
@@ -106,7 +107,7 @@ def test_generate_user_rooms_end_to_end(tmp_path: Path) -> None:
     assert digest_tree(one) == digest_tree(two)  # whatever the workers and hash seed
     assert not any(str(tmp_path) in p.read_text() for p in one.rglob("*.usda"))
 
-    checked = run("validate", str(one), "--usd", "--sources", str(config.parent))
+    checked = run_cli("sgdata", "validate", str(one), "--usd", "--sources", str(config.parent))
     assert checked.returncode == 0, checked.stdout + checked.stderr
     assert "clean" in checked.stdout and "sources.unchanged" in checked.stdout
 
@@ -145,7 +146,9 @@ def test_generate_user_rooms_end_to_end(tmp_path: Path) -> None:
     # the user edits a room afterwards: validate --sources names it, the dataset itself is fine
     with open(config.parent / "rooms" / "yup.usda", "a") as handle:
         handle.write("\n")
-    checked = run("validate", str(one), "--quick", "--sources", str(config.parent), "--json")
+    checked = run_cli(
+        "sgdata", "validate", str(one), "--quick", "--sources", str(config.parent), "--json"
+    )
     assert checked.returncode == 1, checked.stdout + checked.stderr
     problems = json.loads(checked.stdout)["problems"]
     assert [(p["check"], p["field"]) for p in problems] == [

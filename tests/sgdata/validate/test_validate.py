@@ -6,8 +6,6 @@ import hashlib
 import io
 import json
 import shutil
-import subprocess
-import sys
 from collections.abc import Callable
 from pathlib import Path
 
@@ -22,6 +20,8 @@ from sgdata.dataset import Dataset, read_manifest, write_manifest, write_parquet
 from sgdata.dataset.schema import file_schema, observations_schema, schema_at
 from sgdata.errors import DatasetError
 from sgdata.validate import ValidationReport, validate_dataset
+
+from ...cli_runner import run_cli
 
 SHARD = "observations/train/bathroom_000.parquet"  # the mini dataset's train room
 TRIPLETS = "triplets/train.parquet"
@@ -425,8 +425,7 @@ def test_a_format_1_1_dataset_reads_validates_and_migrates(copy: Path, mini_data
     for a, b in zip(pixels(before.column("image")), pixels(after.column("image")), strict=True):
         assert np.array_equal(a, b)
 
-    cli = [sys.executable, "-m", "sgdata_cli.sgdata_app", "migrate"]  # the command, end to end
-    done = subprocess.run([*cli, str(copy)], capture_output=True, text=True, timeout=300)
+    done = run_cli("sgdata", "migrate", copy)  # the command, end to end
     assert done.returncode == 0, done.stderr
     manifest = read_manifest(copy)
     assert manifest.format_version == FORMAT_VERSION
@@ -440,7 +439,7 @@ def test_a_format_1_1_dataset_reads_validates_and_migrates(copy: Path, mini_data
     again = migrate_dataset(copy)  # a current dataset: nothing changes, to the byte
     assert {p.name: p.read_bytes() for p in copy.iterdir() if p.is_file()} == before
     assert again.files == manifest.files and again.format_version == manifest.format_version
-    done = subprocess.run([*cli, str(copy / "scenes")], capture_output=True, text=True)
+    done = run_cli("sgdata", "migrate", copy / "scenes")
     assert done.returncode != 0 and "no dataset.json" in done.stderr
     assert len(done.stderr.strip().splitlines()) == 1
 
@@ -469,8 +468,7 @@ def test_migrating_a_png_that_does_not_decode_names_the_file(copy: Path) -> None
     cells[0] = {"bytes": b"\x89PNG\r\n\x1a\n not a PNG", "path": None}
     broken = pa.array(cells, type=table.schema.field(at).type)
     rewrite(copy, SHARD, table.set_column(at, table.schema.field(at), broken))
-    cli = [sys.executable, "-m", "sgdata_cli.sgdata_app", "migrate", str(copy)]
-    done = subprocess.run(cli, capture_output=True, text=True, timeout=300)
+    done = run_cli("sgdata", "migrate", copy)
     assert done.returncode != 0
     assert len(done.stderr.strip().splitlines()) == 1
     assert SHARD in done.stderr and "does not decode as PNG" in done.stderr
