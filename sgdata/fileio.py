@@ -4,6 +4,8 @@ checks, a file's SHA-256, and TOML files read into one-line errors.
 One protocol writes every file of the project: a temporary file beside the target
 (``.<name>.<random>.tmp``, :data:`TEMP_GLOB`), flushed to disk, then renamed over the target
 (:func:`atomic_file`); a failure removes the temporary file and leaves the target as it was.
+The file gets the mode a plain ``open`` would give it (0666 less the umask: 0644 under 022),
+not the temporary file's private 0600, so other users and servers read what they may.
 """
 
 from __future__ import annotations
@@ -58,6 +60,19 @@ def prepare_output_dir(path: Path) -> Path:
     return path
 
 
+def process_umask() -> int:
+    """This process's umask: read from ``/proc/self/status`` (Linux), else set and restored."""
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("Umask:"):
+                return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
 @contextmanager
 def atomic_file(path: Path) -> Iterator[Path]:
     """A temporary path beside ``path`` to write; on a clean exit it is synced to disk and
@@ -73,6 +88,7 @@ def atomic_file(path: Path) -> Iterator[Path]:
     tmp = Path(name)
     try:
         yield tmp
+        os.chmod(tmp, 0o666 & ~process_umask())  # mkstemp's 0600 is for the temporary only
         fd = os.open(tmp, os.O_RDONLY)
         try:
             os.fsync(fd)

@@ -461,6 +461,27 @@ def pytest_configure(config: pytest.Config) -> None:
         torch.set_num_threads(int(share))
 
 
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """Under xdist (worksteal hands each worker a contiguous share of this order), each
+    worker's share starts with its part of the `slow` tests, the first with the `quiet` ones:
+    long tests start early on every worker and short ones fill the end. Tests marked `gpu`
+    skip, with their reason, where torch sees no GPU."""
+    if not torch.cuda.is_available():
+        for item in items:
+            if item.get_closest_marker("gpu"):
+                item.add_marker(pytest.mark.skip(reason="needs a GPU: torch sees none"))
+    workers = int(getattr(config, "workerinput", {}).get("workercount", 1))
+    quiet = [i for i in items if i.get_closest_marker("quiet")]
+    slow = [i for i in items if i.get_closest_marker("slow") and i not in quiet]
+    rest = iter([i for i in items if i not in quiet and i not in slow])
+    ordered: list[pytest.Item] = []
+    for worker in range(workers):
+        share = len(items) // workers + (worker < len(items) % workers)
+        head = (quiet if worker == 0 else []) + slow[worker::workers]
+        ordered += head + [next(rest) for _ in range(max(0, share - len(head)))]
+    items[:] = ordered + list(rest)
+
+
 # --------------------------------------------------------------------------- a quiet machine
 # A test marked `quiet` times the machine (a budget's calibration against busy loops): under
 # xdist it runs while the other workers wait, so that the quiet side of its comparison is

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import stat
 from pathlib import Path
 
 import pytest
@@ -13,6 +14,7 @@ from sgdata.fileio import (
     atomic_file,
     atomic_write_text,
     parse_toml,
+    process_umask,
     read_toml,
     sha256_file,
 )
@@ -28,6 +30,24 @@ def test_atomic_file_renames_on_success_and_leaves_nothing_on_failure(tmp_path: 
         tmp.write_bytes(b"half")
         raise RuntimeError("killed")
     assert target.read_bytes() == b"new" and os.listdir(target.parent) == ["out.bin"]
+
+
+@pytest.mark.parametrize("mask", [0o022, 0o077, 0o002])
+def test_written_files_take_the_mode_the_umask_gives(tmp_path: Path, mask: int) -> None:
+    """Not mkstemp's private 0600: another user, a container's uid or a web server reads a
+    dataset as a plain ``open`` would have let it."""
+    old = os.umask(mask)
+    try:
+        assert process_umask() == mask
+        atomic_write_text(tmp_path / "out.txt", "x")
+    finally:
+        os.umask(old)
+    assert stat.S_IMODE((tmp_path / "out.txt").stat().st_mode) == 0o666 & ~mask
+
+
+def test_a_generated_dataset_is_readable_as_the_umask_says(mini_dataset: Path) -> None:
+    modes = {stat.S_IMODE(p.stat().st_mode) for p in mini_dataset.rglob("*") if p.is_file()}
+    assert modes == {0o666 & ~process_umask()}  # tables, images, USD, manifest and card alike
 
 
 def test_sha256_file_gives_digest_and_size(tmp_path: Path) -> None:

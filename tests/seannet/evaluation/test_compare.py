@@ -36,6 +36,7 @@ TINY = TrainConfig().replace(
 )
 
 
+@pytest.mark.slow  # a whole comparison trained, selected on val, then read on test
 def test_compare_selects_on_val_before_reading_test(tmp_path: Path, mini_dataset: Path) -> None:
     # the test split is not there until the selection is written: a read of it before then
     # fails the whole comparison

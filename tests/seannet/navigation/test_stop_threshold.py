@@ -45,6 +45,7 @@ def test_a_threshold_is_never_chosen_on_test(tmp_path: Path) -> None:
         choose_epsilon([tmp_path], None, tmp_path, tmp_path, NavigationTestConfig(split="test"))
 
 
+@pytest.mark.slow  # navigation episodes on the live renderer for each tried epsilon
 def test_choose_epsilon_on_the_val_room(
     navigation_run: SimpleNamespace, localizer_run: Path, mini_dataset: Path, tmp_path: Path
 ) -> None:

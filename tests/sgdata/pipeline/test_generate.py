@@ -119,7 +119,11 @@ def test_resume_with_another_config_is_refused(tmp_path: Path, mini_config_file:
         generate_dataset(load_config(mini_config_file), root, resume=True)
 
 
-@pytest.mark.parametrize("executor", ["local", "ray"])
+@pytest.mark.parametrize(
+    "executor",
+    # ray: a local Ray instance started, killed with the run and started again for the resume
+    ["local", pytest.param("ray", marks=pytest.mark.slow)],
+)
 def test_sigkill_mid_run_then_resume(
     tmp_path: Path,
     mini_dataset: Path,
