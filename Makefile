@@ -21,7 +21,7 @@ test: setup
 test-fast: setup
 	$(PYTEST) -q -m "not slow"
 
-# the suite in a shuffled order; the seed it prints repeats an order (-p randomly -p "randomly_seed=N")
+# the suite in a shuffled order: pytest -p randomly --randomly-seed=N repeats the order of seed N
 test-random: setup
 	$(PYTEST) -q -p randomly
 

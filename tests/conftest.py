@@ -1,6 +1,7 @@
 """Shared test fixtures: a tiny hand-built room with its render geometry, one renderer, the
-mini dataset, tiny seannet runs (a localizer, a navigation run), process probes, and a
-session-end check that no process of the run survives."""
+mini dataset, tiny seannet runs (a localizer, a navigation run), built once per run and shared
+by every xdist worker (tests/artefacts.py), process probes, the lock that lets a `quiet` test
+time an idle machine, and a session-end check that no process of the run survives."""
 
 from __future__ import annotations
 
@@ -226,19 +227,25 @@ def mini_config_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return path
 
 
-@pytest.fixture(scope="session")
-def mini_dataset(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """Root of the generated mini dataset (real USD, Parquet and PNG), built once per run."""
+def generated_dataset(tmp_path_factory: pytest.TempPathFactory, name: str, toml: str) -> Path:
+    """The dataset a config (TOML text) generates, with 2 workers, as the shared artefact
+    ``name``: generated once per test run."""
 
     def build(root: Path) -> None:
         from sgdata.pipeline.config import load_config
         from sgdata.pipeline.generate import generate_dataset
 
-        config_file = root.parent / "mini.toml"
-        config_file.write_text(MINI_TOML)
+        config_file = root.parent / f"{name}.toml"
+        config_file.write_text(toml)
         generate_dataset(load_config(config_file), root, workers=2)
 
-    return shared_artefact(tmp_path_factory, "mini_dataset", build)
+    return shared_artefact(tmp_path_factory, name, build)
+
+
+@pytest.fixture(scope="session")
+def mini_dataset(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Root of the generated mini dataset (real USD, Parquet and PNG), built once per run."""
+    return generated_dataset(tmp_path_factory, "mini_dataset", MINI_TOML)
 
 
 # The mini dataset with the optional channels on (depth and instance masks): the channel
@@ -249,16 +256,7 @@ CHANNELS_TOML = MINI_TOML + "[outputs]\ndepth = true\ninstances = true\n"
 @pytest.fixture(scope="session")
 def channels_dataset(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """Root of the mini dataset generated with ``[outputs] depth`` and ``instances`` on."""
-
-    def build(root: Path) -> None:
-        from sgdata.pipeline.config import load_config
-        from sgdata.pipeline.generate import generate_dataset
-
-        config_file = root.parent / "channels.toml"
-        config_file.write_text(CHANNELS_TOML)
-        generate_dataset(load_config(config_file), root, workers=2)
-
-    return shared_artefact(tmp_path_factory, "channels_dataset", build)
+    return generated_dataset(tmp_path_factory, "channels_dataset", CHANNELS_TOML)
 
 
 # --------------------------------------------------------------------------- seannet runs

@@ -5,7 +5,6 @@ the boxes back, YOLO labels are the stored boxes; bad input is one line and writ
 from __future__ import annotations
 
 import json
-import sys
 from collections import Counter
 from pathlib import Path
 
@@ -21,7 +20,6 @@ from sgdata.label.yolo_export import export_yolo
 from ...cli_runner import Done, run_cli
 
 pytest.importorskip("pycocotools")
-CLI = [sys.executable, "-m", "sgdata_cli.sgdata_app", "export"]
 
 
 def _boxes(root: Path, split: str) -> Counter:
