@@ -2,7 +2,7 @@
 # The suite runs on every core (pytest-xdist): shared artefacts are built once under a file lock
 # (tests/artefacts.py), and tests marked `quiet` run while the other workers wait. One worker
 # more than cores: a worker waits part of its time (on a lock, a server, a subprocess), and
-# the extra one fills those gaps (2 cores: 3 workers 512 s, 2 workers 531-578 s).
+# the extra one fills those gaps (2 cores: 3 workers 484-532 s, 2 workers 531-578 s).
 .PHONY: setup demo test test-fast test-random test-coverage lint
 
 WORKERS ?= $(shell echo $$(( $$(nproc) + 1 )))
