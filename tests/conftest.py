@@ -462,9 +462,9 @@ def pytest_configure(config: pytest.Config) -> None:
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     """Tests marked `quiet` first (their wait for the other workers is shortest before those
     are deep in long tests), the rest in file order: the slow protocol tests of tests/bench/
-    then share one worker's part, which keeps the run's disk peak near 2 GB (started together
-    on every worker they wrote 4.5 GB of checkpoints, for no gain in time). Tests marked `gpu`
-    skip, with their reason, where torch sees no GPU."""
+    then share one worker's part, which keeps the run's disk peak at 2.7-2.9 GB (started
+    together on every worker they wrote 4.5 GB of checkpoints, for no gain in time). Tests
+    marked `gpu` skip, with their reason, where torch sees no GPU."""
     if not torch.cuda.is_available():
         for item in items:
             if item.get_closest_marker("gpu"):
