@@ -4,8 +4,8 @@
     python bench/train_step.py DATA --gcn-forms [--steps 6]  # SeanNet's GCN: dense vs nodes
     python bench/train_step.py DATA --profile [--steps 3]    # where SeanNet's step goes
 
-By default, every network that docs/results.md trains (``bench/results.py``'s headline, fc and
-ablation networks; ``--models`` names others) is timed by
+By default, every network that docs/results.md trains (the protocol's networks,
+:data:`seannet.protocol.design.DESIGN`; ``--models`` names others) is timed by
 :func:`seannet.training.budget.calibrate`, the function that sets a run's batches: torch on one
 thread, the thread's own CPU clock, each batch's fastest of two rounds, on real triplet batches
 of DATA's train split. Each network's step, the rounds' spread, the share of wall time that
@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 import time
 from collections import defaultdict
 from collections.abc import Callable, Iterator, Sequence
@@ -39,26 +38,22 @@ from typing import Any
 import torch
 from torch.utils.data import DataLoader
 
-BENCH = Path(__file__).resolve().parent
-sys.path.insert(0, str(BENCH.parent))
-sys.path.append(str(BENCH))  # for results.py; last, so no bench script shadows a package
-
-from results import ABLATIONS, FC, HEADLINE  # noqa: E402
-
-from seannet.data.datasets import ImageTransform, TripletDataset, collate_triplets  # noqa: E402
-from seannet.errors import ModelError  # noqa: E402
-from seannet.evaluation.compare import model_spec  # noqa: E402
-from seannet.model.loss import TripletLoss  # noqa: E402
-from seannet.model.seannet import SeanNet  # noqa: E402
-from seannet.model.specs import parse_spec  # noqa: E402
-from seannet.training.budget import calibrate  # noqa: E402
-from seannet.training.config import TrainConfig, preset  # noqa: E402
-from seannet.training.loop import train_one_epoch, triplet_step  # noqa: E402
-from seannet.training.runs import build_for_dataset  # noqa: E402
+from seannet.data.datasets import ImageTransform, TripletDataset, collate_triplets
+from seannet.errors import ModelError
+from seannet.evaluation.compare import model_spec
+from seannet.model.loss import TripletLoss
+from seannet.model.seannet import SeanNet
+from seannet.protocol.design import DESIGN, network_of
+from seannet.training.budget import calibrate
+from seannet.training.config import TrainConfig, preset
+from seannet.training.loop import train_one_epoch, triplet_step
+from seannet.training.runs import build_for_dataset
 
 # the networks docs/results.md trains (a scene term adds no training step), ResNet-18 first
 RESULTS_NETWORKS = tuple(
-    dict.fromkeys(parse_spec(spec).trained for spec in ("resnet18", *HEADLINE, *FC, *ABLATIONS))
+    dict.fromkeys(
+        ["resnet18", *(n for n in (network_of(r.method) for r in DESIGN.rows) if n is not None)]
+    )
 )
 
 

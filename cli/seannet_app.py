@@ -526,6 +526,103 @@ def leaderboard(
         console.print(f"wrote {out}")
 
 
+results_app = typer.Typer(
+    help="The protocol of docs/results.md as units of at most 45 min, each ending in a "
+    "committed record: plan them, run them under a time limit, write the docs from records.",
+    no_args_is_help=True,
+)
+app.add_typer(results_app, name="results")
+Records = Annotated[
+    Path, typer.Option(help="Records root: one folder per dataset recipe (tracked).")
+]
+Methods = Annotated[
+    str,
+    typer.Option(
+        help="Comma-separated methods to add to the protocol's rows (names, import paths or "
+        "model specs): your method in our tables."
+    ),
+]
+
+
+def _design(methods: str):  # noqa: ANN202 - seannet.protocol is imported late
+    from seannet.protocol.design import DESIGN
+
+    return DESIGN.with_methods([m.strip() for m in methods.split(",") if m.strip()])
+
+
+def _duration(text: str) -> float:
+    """``50m``, ``2h``, ``90s`` or plain seconds, as seconds."""
+    units = {"s": 1.0, "m": 60.0, "h": 3600.0}
+    try:
+        value = float(text[:-1]) * units[text[-1]] if text[-1:] in units else float(text)
+    except ValueError:
+        raise typer.BadParameter(f"{text!r}: expected a duration such as 50m, 2h or 90s") from None
+    if value <= 0:
+        raise typer.BadParameter(f"{text!r}: expected a duration above 0")
+    return value
+
+
+@results_app.command(name="plan")
+def results_plan(
+    data: Data, records: Records = Path("results/records"), methods: Methods = ""
+) -> None:
+    """The units each doc needs: recorded, to run (with estimates), waiting on a choice."""
+    from seannet.protocol.runner import plan_text, status
+
+    typer.echo(plan_text(status(_design(methods), data, records)))
+
+
+@results_app.command(name="run")
+def results_run(
+    data: Data,
+    for_: Annotated[
+        str | None,
+        typer.Option("--for", help="Time to spend, e.g. 50m: no unit starts that cannot finish."),
+    ] = None,
+    units: Annotated[int | None, typer.Option(help="Run at most this many units.")] = None,
+    records: Records = Path("results/records"),
+    work: Annotated[
+        Path, typer.Option(help="The units' working files (gitignored; emptied per unit).")
+    ] = Path("runs/protocol"),
+    docs: Annotated[
+        Path | None, typer.Option(help="Write the docs here after each unit (e.g. docs).")
+    ] = None,
+    methods: Methods = "",
+) -> None:
+    """Run missing units until the time or unit count is spent; each ends in a record."""
+    from seannet.protocol.runner import run_for
+
+    design = _design(methods)
+    seconds = None if for_ is None else _duration(for_)
+    written = run_for(design, data, records, work, seconds=seconds, units=units,
+                      say=console.print, docs=docs)  # fmt: skip
+    console.print(f"{len(written)} unit(s) recorded" + "".join(f"\n  {p}" for p in written))
+
+
+@results_app.command(name="doc")
+def results_doc(
+    data: Annotated[
+        Path | None,
+        typer.Option(
+            "--data",
+            help="The dataset whose recipe's records to read (default: the "
+            "only recipe folder under --records).",
+        ),
+    ] = None,
+    records: Records = Path("results/records"),
+    out: Annotated[Path, typer.Option(help="Where the docs go.")] = Path("docs"),
+    methods: Methods = "",
+) -> None:
+    """results.md, learning-curve.md (+ plot) and leaderboard.md from the records alone."""
+    from seannet.protocol.docs import Records as Read
+    from seannet.protocol.docs import write_docs
+    from seannet.protocol.records import find_folder
+
+    found = find_folder(records, data)
+    for path in write_docs(Read(_design(methods), found), out):
+        console.print(f"wrote {path}")
+
+
 def _errors() -> tuple[type[Exception], ...]:
     from seannet.errors import SeannetError
 

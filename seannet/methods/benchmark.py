@@ -58,7 +58,14 @@ from seannet.methods.checks import (
 from seannet.methods.registry import load_method
 from seannet.methods.views import Budget, SplitData
 
-__all__ = ["BenchmarkConfig", "NOISE_LEVELS", "benchmark_method", "breaking_point", "summarize"]
+__all__ = [
+    "BenchmarkConfig",
+    "NOISE_LEVELS",
+    "benchmark_method",
+    "breaking_point",
+    "run_seed",
+    "summarize",
+]
 
 NOISE_LEVELS = (
     BoxNoise(jitter=0.05),
@@ -224,7 +231,8 @@ def _recall(h: _Harness, e: _Embedded, map_layout: int) -> dict[str, Any]:
         pairs += [(e.obs_ids[k], e.obs_ids[map_idx[t]]) for k, t in zip(q, truth, strict=True)]
     rank = np.concatenate(ranks) if ranks else np.zeros(0, np.int64)
     return {
-        "recall": {k: float((rank < k).mean()) if len(rank) else float("nan") for k in (1, 5)},
+        # keyed "1" and "5", as JSON keeps them: a result read back is the result written
+        "recall": {str(k): float((rank < k).mean()) if len(rank) else float("nan") for k in (1, 5)},
         "queries": int(len(rank)),
         "_hits": rank < 1,
         "_pairs": pairs,
@@ -251,27 +259,31 @@ def _triplets(h: _Harness, e: _Embedded, split: str) -> tuple[np.ndarray, dict[s
     return correct, {**result, "_pairs": pairs}
 
 
-def _one_seed(
+def run_seed(
     name: str, factory: Callable[[], Any], data: Path, config: BenchmarkConfig, seed: int,
     work: Path, say: Callable[[str], None],
 ) -> tuple[dict[str, Any], Any]:  # fmt: skip
-    """The protocol for one seed: its results, and the (fitted) method."""
+    """The protocol for one seed: its results, and the (fitted) method. Its val triplet
+    accuracy (``val_accuracy``) is what a choice between runs reads; test is read here once."""
     torch.manual_seed(seed)
     method = guarded(name, "its factory", factory)
     if not callable(getattr(method, "embed", None)):
         raise MethodError(f"method {name!r}: has no embed(views) (check: interface)")
     h = _Harness(name, method, data, config)
     fit = getattr(method, "fit", None)
+    fitting = time.perf_counter()
     if fit is not None:
         say(f"{name}: fit, seed {seed}")
         budget = Budget(seed=seed, preset=config.preset, batches=config.batches,
                         epochs=config.epochs, lrs=config.lrs, work=work)  # fmt: skip
         guarded(name, "fit", fit, h.split_data("train"), h.split_data("val"), budget)
+    fit_s = time.perf_counter() - fitting
     say(f"{name}: val (epsilon), seed {seed}")
     val = h.embed("val")
     first, second, steps = _pose_pairs(val)
     s = h.scores(val.vectors, first, second)
     threshold = _choose_epsilon(s[steps == 0], s[steps == 1])
+    val_correct, _ = _triplets(h, val, "val")
     say(f"{name}: test, seed {seed}")
     test = h.embed("test")
     correct, metrics = _triplets(h, test, "test")
@@ -286,6 +298,7 @@ def _one_seed(
     result: dict[str, Any] = {
         "seed": seed,
         "trained": fit is not None,
+        "val_accuracy": float(val_correct.mean()) if len(val_correct) else float("nan"),
         **metrics,
         "threshold": {**threshold, "rule": "max balanced accuracy, same pose vs one step (val)"},
         "threshold_on_test": {
@@ -301,6 +314,7 @@ def _one_seed(
             "bytes_per_map_entry": int(test.vectors.shape[1] * test.vectors.element_size()),
             "dim": int(test.vectors.shape[1]),
             "torch_threads": torch.get_num_threads(),
+            "fit_s": fit_s,
         },
         "choices": dict(getattr(method, "choices", {}) or {}),
     }
@@ -349,8 +363,8 @@ def summarize(runs: list[dict[str, Any]]) -> dict[str, Any]:
         "seeds": len(runs),
         "accuracy": t_interval([r["accuracy"] for r in runs]),
         "accuracy_rooms_seeds": two_level_interval(per_room_matrix(runs, rooms), weight),
-        "recall1": t_interval([r["retrieval"]["recall"][1] for r in runs]),
-        "recall5": t_interval([r["retrieval"]["recall"][5] for r in runs]),
+        "recall1": t_interval([r["retrieval"]["recall"]["1"] for r in runs]),
+        "recall5": t_interval([r["retrieval"]["recall"]["5"] for r in runs]),
         "epsilon": float(np.mean([r["threshold"]["epsilon"] for r in runs])),
         "per_tier": {
             t: float(np.mean([r["per_tier"][t] for r in runs])) for t in runs[0]["per_tier"]
@@ -396,11 +410,11 @@ def benchmark_method(
     say = announce or (lambda _text: None)
     factory, _ = load_method(name)
     work = out / "runs"
-    first, method = _one_seed(name, factory, data, config, config.seeds[0], work, say)
+    first, method = run_seed(name, factory, data, config, config.seeds[0], work, say)
     runs = [first]
     trained = first["trained"]  # a method with fit() trains once per seed
     if trained:
-        runs += [_one_seed(name, factory, data, config, s, work, say)[0] for s in config.seeds[1:]]
+        runs += [run_seed(name, factory, data, config, s, work, say)[0] for s in config.seeds[1:]]
     summary = summarize(runs)
     directory = card_dir(out, name)
     directory.mkdir(parents=True, exist_ok=True)

@@ -10,6 +10,7 @@ version check (:func:`sgdata.schema.check_compatible`) and the migrations of old
 
 from __future__ import annotations
 
+import hashlib
 import json
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
@@ -207,6 +208,15 @@ class Manifest:
                 for f in self.files
             ],
         }
+
+    def recipe_fingerprint(self) -> str:
+        """sha256 of what was asked for: every field but what generation produced (``counts``
+        and ``files``). The same wherever the same config, seed, generator and format made
+        the dataset, even where the bytes differ (renderers on other CPUs); results recorded
+        per dataset combine on it (DESIGN §12)."""
+        recipe = {k: v for k, v in self.to_dict().items() if k not in ("counts", "files")}
+        text = json.dumps(recipe, sort_keys=True, ensure_ascii=False, separators=(",", ":"))
+        return hashlib.sha256(text.encode()).hexdigest()
 
     def to_json(self) -> str:
         """Deterministic text of ``dataset.json`` (indent 2, trailing newline, no timestamps)."""

@@ -67,7 +67,7 @@ def test_step_costs_are_the_budgets_calibration_and_branch_motion_trains_by_the_
     comparison's budget table shows), its --gcn-forms and bench/branch_motion.py run
     seannet.training's own step (train_one_epoch over triplet_step) on the mini dataset."""
     bench = _bench()
-    # by default, the networks bench/results.py trains, once each, ResNet-18 first
+    # by default, the networks the protocol trains (seannet.protocol), once each, ResNet-18 first
     assert bench.RESULTS_NETWORKS[0] == "resnet18" and "seannet-nolayout" in bench.RESULTS_NETWORKS
     assert not any("+" in name for name in bench.RESULTS_NETWORKS)
     assert len(set(bench.RESULTS_NETWORKS)) == len(bench.RESULTS_NETWORKS)

@@ -206,10 +206,11 @@ def test_the_leaderboard_says_where_a_method_breaks_or_how_far_the_change_reache
     assert _breaks(summary, "moved_objects") == "never (3-5: 75.0 %)"
 
 
-def test_the_docs_leaderboard_is_its_cards() -> None:
-    docs = Path(__file__).parents[3] / "docs"
-    assert (docs / "leaderboard.md").read_text() == leaderboard(read_cards([docs / "cards"])), (
-        "docs/leaderboard.md: run `seannet leaderboard docs/cards --out docs/leaderboard.md`"
+def test_the_cards_leaderboard_is_its_cards() -> None:
+    cards = Path(__file__).parents[3] / "docs" / "cards"
+    assert (cards / "leaderboard.md").read_text() == leaderboard(read_cards([cards])), (
+        "docs/cards/leaderboard.md: run "
+        "`seannet leaderboard docs/cards --out docs/cards/leaderboard.md`"
     )
 
 

@@ -1,0 +1,241 @@
+"""The protocol as units with committed records (``seannet results``): real training on the
+mini dataset, tiny budgets. Interrupted runs give the same docs as one run; a killed unit
+leaves nothing and is redone alone; another recipe's record is left out; a unit above the
+limit is refused with its estimate."""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from seannet.data.box_noise import BoxNoise
+from seannet.protocol.design import AIM, Design, Row, plan_units
+from seannet.protocol.docs import Records, write_docs
+from seannet.protocol.records import find_folder, read_records
+from seannet.protocol.runner import plan_text, run_for, status
+from tests.artefacts import shared_artefact
+from tests.cli_runner import run_cli
+
+# 4 units: tiny-image (no training), resnet18 at each lr with seed 0, then the chosen lr's
+# seed 1; one batch of one epoch, so a unit takes seconds
+TINY = Design(
+    rows=(Row("resnet18+boxes", seeds=2, noise=True), Row("tiny-image", seeds=1)),
+    batches=1,
+    epochs=1,
+    noise_grid=(BoxNoise(jitter=0.05), AIM),
+)
+DOCS = ("results.md", "learning-curve.md", "leaderboard.md")
+
+
+def _docs(found_root: Path, out: Path) -> dict[str, str]:
+    write_docs(Records(TINY, find_folder(found_root, None)), out)
+    return {name: (out / name).read_text() for name in DOCS}
+
+
+@pytest.fixture(scope="session")
+def protocol_records(tmp_path_factory: pytest.TempPathFactory, mini_dataset: Path) -> Path:
+    """The records root of the tiny protocol run in one uninterrupted call."""
+
+    def build(root: Path) -> None:
+        written = run_for(TINY, mini_dataset, root, root.parent / "protocol-work")
+        assert len(written) == 4
+
+    return shared_artefact(tmp_path_factory, "protocol_records", build)
+
+
+def _val_record(val: dict[str, float], noise: tuple[str, ...] = ()) -> dict:
+    """What the planner reads of a seed-0 record: its evaluations and val accuracies."""
+    return {
+        "evaluations": [{"method": m, "noise": list(noise), "full_map": False} for m in val],
+        "results": {m: {"val_accuracy": v} for m, v in val.items()},
+    }
+
+
+def test_plan_chooses_the_lr_on_val_then_plans_the_other_seeds() -> None:
+    design = Design(rows=(Row("resnet18+boxes", seeds=3), Row("resnet18", seeds=2)))
+    first = plan_units(design, {})
+    names = [u.name for u in first.todo]
+    assert names == ["resnet18-b300-lr0.003-s0", "resnet18-b300-lr0.01-s0"]
+    assert first.pending == 2 and first.open_ended  # two specs may choose apart
+
+    # +boxes is best at 0.01, plain resnet18 ties: the smaller lr
+    records = {
+        "resnet18-b300-lr0.003-s0": _val_record({"resnet18+boxes": 0.70, "resnet18": 0.80}),
+        "resnet18-b300-lr0.01-s0": _val_record({"resnet18+boxes": 0.75, "resnet18": 0.80}),
+    }
+    then = plan_units(design, records)
+    assert [u.name for u in then.done] == names
+    todo = {u.name: [e.method for e in u.evaluations] for u in then.todo}
+    assert todo == {
+        "resnet18-b300-lr0.003-s1": ["resnet18"],
+        "resnet18-b300-lr0.01-s1": ["resnet18+boxes"],
+        "resnet18-b300-lr0.01-s2": ["resnet18+boxes"],
+    }
+    assert then.pending == 0
+    # a record that lacks an evaluation the design asks is run again
+    del records["resnet18-b300-lr0.01-s0"]["results"]["resnet18"]
+    again = plan_units(design, records)
+    assert [u.name for u in again.todo] == ["resnet18-b300-lr0.01-s0"] and again.pending == 2
+
+
+def test_one_seed_carries_the_noise_grid_and_every_seed_the_aim() -> None:
+    design = Design(rows=(Row("resnet18+boxes", seeds=3, noise=True, full_map=True),))
+    records = {
+        f"resnet18-b300-lr{lr:g}-s0": _val_record({"resnet18+boxes": 0.5}, (AIM.label(),))
+        for lr in design.lrs
+    }
+    units = {u.seed: u.evaluations[0] for u in plan_units(design, records).todo}
+    assert units[1].noise == design.noise_grid and units[1].full_map
+    assert units[2].noise == (design.aim,) and not units[2].full_map
+    zero = plan_units(design, {}).todo[0].evaluations[0]
+    assert zero.noise == (design.aim,) and not zero.full_map  # before the lr is chosen
+
+
+def test_an_interrupted_protocol_gives_the_docs_of_one_run(
+    protocol_records: Path, mini_dataset: Path, tmp_path: Path
+) -> None:
+    whole = _docs(protocol_records, tmp_path / "whole")
+    assert "**Complete**: all 4 units" in whole["results.md"]
+    records = tmp_path / "records"
+    first = run_for(TINY, mini_dataset, records, tmp_path / "work", units=2)
+    assert len(first) == 2
+    part = _docs(records, tmp_path / "part")
+    assert "**2 of 4 units measured**" in part["results.md"]
+    second = run_for(TINY, mini_dataset, records, tmp_path / "work")
+    assert len(second) == 2
+    assert _docs(records, tmp_path / "again") == whole
+
+
+def test_a_doc_of_one_unit_says_so_and_leaves_the_others_cells_empty(
+    protocol_records: Path, tmp_path: Path
+) -> None:
+    records = tmp_path / "records"
+    shutil.copytree(protocol_records, records)
+    folder = next(p for p in records.iterdir() if p.is_dir())
+    for path in folder.glob("*.json"):
+        if path.stem != "tiny-image-s0":
+            path.unlink()
+    text = _docs(records, tmp_path / "docs")["results.md"]
+    assert "**1 of 4 units measured**" in text
+    row = next(line for line in text.splitlines() if line.startswith("| `resnet18+boxes` | 0 of 2"))
+    assert row.replace(" ", "").endswith("|" * 9)  # every figure cell empty
+    assert "| `tiny-image` | 1 |" in text
+
+
+def test_a_record_of_another_recipe_is_left_out_and_the_doc_says_so(
+    protocol_records: Path, tmp_path: Path
+) -> None:
+    records = tmp_path / "records"
+    shutil.copytree(protocol_records, records)
+    folder = next(p for p in records.iterdir() if p.is_dir())
+    alien = json.loads((folder / "tiny-image-s0.json").read_text())
+    alien["dataset"]["recipe"] = "f" * 64
+    alien["results"]["tiny-image"]["accuracy"] = 0.0  # would show if it were read
+    (folder / "tiny-image-s9.json").write_text(json.dumps(alien))
+    found = find_folder(records, None)
+    assert list(found.left_out) == [
+        f"tiny-image-s9.json: another dataset recipe ({'f' * 16}…, not {found.recipe[:16]}…)"
+    ]
+    text = _docs(records, tmp_path / "docs")["results.md"]
+    said = [line for line in text.splitlines() if line.startswith("- Left out")]
+    assert said == [f"- Left out: 1 file(s) of the folder: {found.left_out[0]}."]
+    clean = _docs(protocol_records, tmp_path / "clean")["results.md"]
+    assert [line for line in text.splitlines() if line not in said] == clean.splitlines()
+
+
+def test_the_planner_refuses_a_unit_above_the_limit_naming_its_estimate(
+    mini_dataset: Path, tmp_path: Path
+) -> None:
+    design = Design(rows=(Row("resnet18", seeds=1),), budget_s=3000.0, batches=1, epochs=1)
+    text = plan_text(status(design, mini_dataset, tmp_path / "records"))
+    assert "refused resnet18-b3000-lr0.003-s0: estimated 52 min (prior), above the 45 min" in text
+    said: list[str] = []
+    assert run_for(design, mini_dataset, tmp_path / "records", tmp_path / "work",
+                   say=said.append) == []  # fmt: skip
+    assert any(line.startswith("refused resnet18-b3000-lr0.003-s0") for line in said)
+
+
+def test_run_for_never_starts_a_unit_that_cannot_finish(mini_dataset: Path, tmp_path: Path) -> None:
+    said: list[str] = []
+    got = run_for(TINY, mini_dataset, tmp_path / "records", tmp_path / "work", seconds=60,
+                  say=said.append)  # fmt: skip
+    assert got == []  # the prior says 5 min for tiny-image, 2 min and more for each training
+    assert "not starting tiny-image-s0: ~5 min needed, 60 s left" in said
+
+
+def test_a_unit_killed_half_way_leaves_nothing_and_its_rerun_redoes_it_alone(
+    protocol_records: Path, mini_dataset: Path, tmp_path: Path
+) -> None:
+    records = tmp_path / "records"
+    shutil.copytree(protocol_records, records)
+    folder = next(p for p in records.iterdir() if p.is_dir())
+    (folder / "resnet18-b300-lr0.003-s0.json").unlink()
+    before = {p.name: p.read_bytes() for p in folder.iterdir()}
+    work = tmp_path / "work"
+    script = (
+        "import sys; from pathlib import Path; from tests.seannet.test_protocol import TINY; "
+        "from seannet.protocol.runner import run_for; "
+        "run_for(TINY, Path(sys.argv[1]), Path(sys.argv[2]), Path(sys.argv[3]))"
+    )
+    child = subprocess.Popen(
+        [sys.executable, "-c", script, str(mini_dataset), str(records), str(work)],
+        cwd=Path(__file__).resolve().parents[2], start_new_session=True,
+    )  # fmt: skip
+    history = work / "resnet18-b300-lr0.003-s0" / "runs"
+    deadline = time.monotonic() + 120
+    while not history.exists() and time.monotonic() < deadline and child.poll() is None:
+        time.sleep(0.05)
+    assert history.exists(), "the unit never started"
+    os.killpg(child.pid, signal.SIGKILL)
+    child.wait()
+    assert {p.name: p.read_bytes() for p in folder.iterdir()} == before  # no record, no temp
+    redone = run_for(TINY, mini_dataset, records, work)
+    assert [p.name for p in redone] == ["resnet18-b300-lr0.003-s0.json"]
+    whole = json.loads((protocol_records / folder.name / redone[0].name).read_text())
+    again = json.loads(redone[0].read_text())
+    assert _figures(again) == _figures(whole)  # the same figures as an unbroken unit
+
+
+def _figures(record: dict) -> str:
+    """A unit record's figures as text (NaN included), without the timings of ``cost``."""
+    results = {m: {k: v for k, v in r.items() if k != "cost"} for m, r in record["results"].items()}
+    return json.dumps(results, sort_keys=True)
+
+
+def test_the_results_commands_plan_and_refuse_bad_input(
+    protocol_records: Path, mini_dataset: Path, tmp_path: Path
+) -> None:
+    done = run_cli("seannet", "results", "run", "--data", str(mini_dataset), "--for", "5x")
+    assert done.returncode != 0 and "'5x': expected a duration such as 50m" in done.stderr
+    assert "Traceback" not in done.stderr
+    done = run_cli("seannet", "results", "doc", "--records", str(tmp_path / "none"))
+    assert done.returncode != 0 and "0 recipe folders (none); pass --data" in done.stderr
+    done = run_cli("seannet", "results", "plan", "--data", str(mini_dataset), "--records",
+                   str(protocol_records))  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert (
+        "units recorded" in done.stdout and "to run  seannet-fc512-b300-lr0.003-s0" in done.stdout
+    )
+
+
+def test_records_are_small_and_name_what_made_them(protocol_records: Path) -> None:
+    folder = next(p for p in protocol_records.iterdir() if p.is_dir())
+    found = read_records(folder, find_folder(protocol_records, None).recipe)
+    assert len(found.units) == 4 and not found.left_out
+    for name, record in found.units.items():
+        size = (folder / f"{name}.json").stat().st_size
+        assert size < 64_000, f"{name}: {size} bytes"
+        assert record["provenance"]["commit"] and record["machine"]["cores"]
+        assert record["dataset"]["content_sha256"] in found.content_sha256s
+        assert record["unit"] == name
+    trained = found.units["resnet18-b300-lr0.01-s0"]
+    assert trained["training"]["batches_per_epoch"] == 1
+    assert trained["training"]["calibration"] == {"handed_in": 1}
