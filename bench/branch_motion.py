@@ -12,23 +12,19 @@ through the fusion's two weight blocks).
 from __future__ import annotations
 
 import argparse
-import sys
 from itertools import islice
 from pathlib import Path
 
 import torch
 from torch.utils.data import DataLoader
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-from seannet.data.datasets import ImageTransform, TripletDataset, collate_triplets  # noqa: E402
-from seannet.model.loss import TripletLoss  # noqa: E402
-from seannet.seeds import init_seed  # noqa: E402
-from seannet.training.config import preset  # noqa: E402
-from seannet.training.loop import train_one_epoch, triplet_step  # noqa: E402
-from seannet.training.runs import build_for_dataset  # noqa: E402
-from seannet.training.train import param_groups  # noqa: E402
+from seannet.data.datasets import ImageTransform, TripletDataset, collate_triplets
+from seannet.model.loss import TripletLoss
+from seannet.seeds import init_seed
+from seannet.training.config import preset
+from seannet.training.loop import train_one_epoch, triplet_step
+from seannet.training.runs import build_for_dataset
+from seannet.training.train import param_groups
 
 PARTS = {
     "backbone (C4)": "backbone.",

@@ -12,24 +12,22 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+from sgdata.annotate.annotator import ViewAnnotator
+from sgdata.annotate.records import ViewPose
+from sgdata.dataset.channels import encode_depth, encode_mask
+from sgdata.dataset.rows import encode_image
+from sgdata.dataset.vocabulary import class_vocabulary
+from sgdata.render.renderer import Renderer
+from sgdata.usd.geometry import read_geometry
+from sgdata.usd.room_io import read_room
+from sgdata.world.poses import HEADINGS_DEG, PosesConfig
 
-from sgdata.annotate.annotator import ViewAnnotator  # noqa: E402
-from sgdata.annotate.records import ViewPose  # noqa: E402
-from sgdata.dataset.channels import encode_depth, encode_mask  # noqa: E402
-from sgdata.dataset.rows import encode_image  # noqa: E402
-from sgdata.dataset.vocabulary import class_vocabulary  # noqa: E402
-from sgdata.render.renderer import Renderer  # noqa: E402
-from sgdata.usd.geometry import read_geometry  # noqa: E402
-from sgdata.usd.room_io import read_room  # noqa: E402
-from sgdata.world.poses import HEADINGS_DEG, PosesConfig  # noqa: E402
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def main() -> None:

@@ -21,10 +21,9 @@ import sys
 import tempfile
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
+from sgdata import markdown
 
-from sgdata import markdown  # noqa: E402
+ROOT = Path(__file__).resolve().parents[1]
 
 TEST = "tests/fuzz/test_fuzz.py::test_every_surface_keeps_the_contract"
 COLUMNS = ("surface", "examples tried", "refused (one-line error)", "failures", "known", "seconds")

@@ -19,17 +19,12 @@ from __future__ import annotations
 
 import argparse
 import statistics
-import sys
 import time
-from pathlib import Path
 
 import torch
 from torch.nn import functional as F
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-from seannet.model.layers import MultiPathwayGCN  # noqa: E402
+from seannet.model.layers import MultiPathwayGCN
 
 CLASSES, SLOTS_PER_CLASS = 107, 2
 

@@ -28,7 +28,6 @@ from __future__ import annotations
 import argparse
 import os
 import statistics
-import sys
 import tempfile
 import time
 from collections.abc import Callable
@@ -37,15 +36,11 @@ from pathlib import Path
 import numpy as np
 import pyarrow.parquet as pq
 import torch
+from torch.utils.data import DataLoader
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-from torch.utils.data import DataLoader  # noqa: E402
-
-from seannet.data.datasets import ImageTransform, TripletDataset, collate_triplets  # noqa: E402
-from seannet.data.image_cache import open_image_cache  # noqa: E402
-from sgdata.dataset import Dataset, decode_image  # noqa: E402
+from seannet.data.datasets import ImageTransform, TripletDataset, collate_triplets
+from seannet.data.image_cache import open_image_cache
+from sgdata.dataset import Dataset, decode_image
 
 
 def generate_tiny(root: Path) -> None:

@@ -36,29 +36,25 @@ from __future__ import annotations
 import argparse
 import json
 import re
-import sys
 from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-import seannet  # noqa: E402,F401  (imports torch's compiler stack first: see tests/conftest.py)
-from seannet.data.datasets import dataset_identity  # noqa: E402
-from seannet.data.live_views import LiveRooms  # noqa: E402
-from seannet.markdown import table  # noqa: E402
-from seannet.navigation.benchmark import results_path, run_navigation, seed_maps  # noqa: E402
-from seannet.navigation.config import FUSIONS, NavigationTestConfig, NavigatorConfig  # noqa: E402
-from seannet.navigation.navigator_training import fit_navigator, train_navigator  # noqa: E402
-from seannet.navigation.pairs import PairSet, render_pairs  # noqa: E402
-from seannet.navigation.stop_threshold import (  # noqa: E402
+import seannet  # noqa: F401  (imports torch's compiler stack first: see tests/conftest.py)
+from seannet.data.datasets import dataset_identity
+from seannet.data.live_views import LiveRooms
+from seannet.markdown import table
+from seannet.navigation.benchmark import results_path, run_navigation, seed_maps
+from seannet.navigation.config import FUSIONS, NavigationTestConfig, NavigatorConfig
+from seannet.navigation.navigator_training import fit_navigator, train_navigator
+from seannet.navigation.pairs import PairSet, render_pairs
+from seannet.navigation.stop_threshold import (
     EPSILON_OFFSETS,
     VAL_EPISODES,
     VAL_EPSILON,
     choose_epsilon,
 )
-from seannet.navigation.tables import (  # noqa: E402
+from seannet.navigation.tables import (
     INTERVAL,
     RATE_HEADER,
     SPLIT_HEADER,
@@ -67,16 +63,18 @@ from seannet.navigation.tables import (  # noqa: E402
     read_results,
     time_rows,
 )
-from seannet.provenance import (  # noqa: E402
+from seannet.provenance import (
     append_provenance,
     provenance_record,
     read_provenance,
     stamp,
 )
-from seannet.training.runs import BEST, HISTORY, load_checkpoint  # noqa: E402
-from seannet.weights import LITE0_WEIGHTS  # noqa: E402
-from sgdata.dataset import Dataset  # noqa: E402
-from sgdata.fileio import atomic_write_text  # noqa: E402
+from seannet.training.runs import BEST, HISTORY, load_checkpoint
+from seannet.weights import LITE0_WEIGHTS
+from sgdata.dataset import Dataset
+from sgdata.fileio import atomic_write_text
+
+ROOT = Path(__file__).resolve().parents[1]
 
 # docs/navigation.md's runs: the test's defaults, the navigator's with more pairs than the CLI's
 TEST = NavigationTestConfig(replan=True)

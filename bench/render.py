@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import sys
 import tempfile
 import time
 from collections.abc import Callable
@@ -29,25 +28,14 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-from sgdata.annotate.annotator import ViewAnnotator  # noqa: E402
-from sgdata.annotate.records import ViewPose  # noqa: E402
-from sgdata.annotate.slots import SlotTable  # noqa: E402
-from sgdata.render.camera import CameraConfig  # noqa: E402
-from sgdata.render.renderer import Renderer  # noqa: E402
-from sgdata.usd.meshes import SceneGeometry  # noqa: E402
-from sgdata.world.poses import pose_grid  # noqa: E402
-from sgdata.world.scene import Room  # noqa: E402
-
-
-def synthetic_scenes() -> list[tuple[Room, SceneGeometry]]:
-    sys.path.insert(0, str(ROOT / "tests"))
-    from conftest import build_tiny_room  # the tests' hand-built room
-
-    tiny = build_tiny_room()
-    return [(tiny.room, tiny.geometry)]
+from sgdata.annotate.annotator import ViewAnnotator
+from sgdata.annotate.records import ViewPose
+from sgdata.annotate.slots import SlotTable
+from sgdata.render.camera import CameraConfig
+from sgdata.render.renderer import Renderer
+from sgdata.usd.meshes import SceneGeometry
+from sgdata.world.poses import pose_grid
+from sgdata.world.scene import Room
 
 
 def generated_scenes(n: int, seed: int) -> list[tuple[Room, SceneGeometry]]:
@@ -147,7 +135,6 @@ def rate(fn: Callable[[ViewPose], object], poses: list[ViewPose]) -> float:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--synthetic", action="store_true", help="use the tests' tiny room")
     ap.add_argument("--rooms", type=int, default=1, help="generated rooms to bench")
     ap.add_argument("--views", type=int, default=40, help="views per room and measurement")
     ap.add_argument("--seed", type=int, default=0)
@@ -155,7 +142,7 @@ def main() -> None:
     ap.add_argument("--json", action="store_true", help="print one JSON line of the means")
     args = ap.parse_args()
 
-    scenes = synthetic_scenes() if args.synthetic else generated_scenes(args.rooms, args.seed)
+    scenes = generated_scenes(args.rooms, args.seed)
     classes = sorted({o.class_name for room, _ in scenes for o in room.objects})
     slots = SlotTable.from_counts([(c, 8) for c in classes], num_slots=max(256, 8 * len(classes)))
     renderer = Renderer(id_pass=args.id_pass)

@@ -45,18 +45,15 @@ from pathlib import Path
 import numpy as np
 import pyarrow.parquet as pq
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-from sgdata import markdown  # noqa: E402
-from sgdata.dataset import decode_image  # noqa: E402
-from sgdata.dataset.paths import observations_path  # noqa: E402
-from sgdata.pipeline import room_tasks  # noqa: E402
-from sgdata.pipeline.config import GenerateConfig, load_config  # noqa: E402
-from sgdata.pipeline.ledger import read_record, scene_record  # noqa: E402
-from sgdata.stage_clock import OTHER, StageClock  # noqa: E402
-from sgdata.world.poses import HEADINGS_DEG  # noqa: E402
-from sgdata.world.triplets import PoseKey  # noqa: E402
+from sgdata import markdown
+from sgdata.dataset import decode_image
+from sgdata.dataset.paths import observations_path
+from sgdata.pipeline import room_tasks
+from sgdata.pipeline.config import GenerateConfig, load_config
+from sgdata.pipeline.ledger import read_record, scene_record
+from sgdata.stage_clock import OTHER, StageClock
+from sgdata.world.poses import HEADINGS_DEG
+from sgdata.world.triplets import PoseKey
 
 PNG_LEVELS = (1, 3, 6, 9)
 

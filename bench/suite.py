@@ -52,12 +52,11 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, NamedTuple
 
+from seannet.provenance import ProcessState
+from sgdata.fileio import atomic_write_text
+
 BENCH = Path(__file__).resolve().parent
 ROOT = BENCH.parent
-sys.path.insert(0, str(ROOT))
-
-from seannet.provenance import ProcessState  # noqa: E402
-from sgdata.fileio import atomic_write_text  # noqa: E402
 
 PY = sys.executable
 PAGE = ROOT / "docs" / "benchmarks.md"

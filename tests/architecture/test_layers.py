@@ -26,7 +26,7 @@ STAGES = (
 )
 # seannet's stages from the bottom up; its top-level modules (errors, weights: plain facts)
 # sit below them all
-SEANNET_STAGES = ("data", "model", "training", "evaluation", "methods", "navigation")
+SEANNET_STAGES = ("data", "model", "training", "evaluation", "methods", "navigation", "protocol")
 # The sgdata a seannet module may import: the dataset and its vocabularies (classes, relation
 # types), seeds, atomic files, errors. Only the live views (rendering a dataset's rooms again)
 # reach the generator's stages.
