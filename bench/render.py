@@ -1,10 +1,8 @@
 """Views per second: bare pyrender passes (RGB, id) against the full view pipeline, and
 plain pyrender (one node per object, an RGB and a SEG pass) on the same views.
 
-    python bench/render.py --synthetic            # the tests' tiny room, runs today
     python bench/render.py --rooms 2 --views 40   # generated rooms (sgdata.world.rooms + usd)
     LP_NUM_THREADS=1 python bench/render.py --rooms 4 --json   # one thread, machine-readable
-    LP_NUM_THREADS=1 python bench/render.py --synthetic
 
 Prints frames per second of the RGB pass, the id pass, both (what the pipeline must do) and
 the full pipeline (render -> annotate -> slots -> relations), and the pipeline's ratio to the
