@@ -300,6 +300,9 @@ def run_seed(
         "trained": fit is not None,
         "val_accuracy": float(val_correct.mean()) if len(val_correct) else float("nan"),
         **metrics,
+        # each test triplet right (1) or wrong (0), in the split's row order: any later
+        # breakdown (by direction, by covisibility) is read from it without training again
+        "test_correct": "".join("1" if c else "0" for c in correct),
         "threshold": {**threshold, "rule": "max balanced accuracy, same pose vs one step (val)"},
         "threshold_on_test": {
             "precision": float((same > eps).sum()) / positives if positives else float("nan"),
