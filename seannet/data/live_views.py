@@ -194,6 +194,23 @@ class LiveRooms:
         rgb, _ = self.renderer.render_rgb(x, y, theta, depth=False)
         return self._stored(rgb)
 
+    def depth(self, i: int, j: int, heading: int) -> np.ndarray:
+        """The view's forward depth (H, W) float32 in metres, 0 where nothing is drawn."""
+        _, x, y, theta = self._pose(i, j, heading)
+        _, metres = self.renderer.render_rgb(x, y, theta, depth=True)
+        return metres
+
+    def covisibility(
+        self,
+        a: tuple[np.ndarray, tuple[float, float, float]],
+        b: tuple[np.ndarray, tuple[float, float, float]],
+    ) -> float:
+        """Covisibility of two views given as (depth, (x, y, theta)), with the dataset's
+        camera (:func:`sgdata.render.covisibility.covisibility`)."""
+        from sgdata.render.covisibility import covisibility
+
+        return covisibility(self.renderer.camera, a[0], a[1], b[0], b[1])
+
     def tensors(self, record: Any, transform: ImageTransform) -> ViewTensors:
         """A rendered view as model input (see :func:`view_tensors`)."""
         return view_tensors(record, transform, self.class_ids, self.num_slots)

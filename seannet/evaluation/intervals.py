@@ -31,6 +31,7 @@ __all__ = [
     "two_level_difference",
     "two_level_interval",
     "welch_difference",
+    "wilson_interval",
 ]
 
 RESAMPLES = 10_000
@@ -44,6 +45,18 @@ def t_interval(values: Sequence[float]) -> dict[str, float]:
     std = float(x.std(ddof=1)) if n > 1 else float("nan")
     half = float(stats.t.ppf(0.975, n - 1) * std / math.sqrt(n)) if n > 1 else float("nan")
     return {"mean": float(x.mean()), "std": std, "ci95": half, "n": n}
+
+
+def wilson_interval(hits: int, n: int) -> dict[str, float]:
+    """A share ``hits / n`` with its 95 % Wilson score interval (a deterministic count over
+    ``n`` independent-enough items: no seeds to add)."""
+    if n == 0:
+        return {"mean": float("nan"), "low": float("nan"), "high": float("nan"), "n": 0}
+    z = float(stats.norm.ppf(0.975))
+    p = hits / n
+    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return {"mean": p, "low": centre - half, "high": centre + half, "n": n}
 
 
 def welch_difference(a: Sequence[float], b: Sequence[float]) -> dict[str, float]:

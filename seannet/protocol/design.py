@@ -30,6 +30,7 @@ from seannet.errors import ModelError
 
 __all__ = [
     "AIM",
+    "COVISIBILITY",
     "DEFAULT_BUDGET_S",
     "DESIGN",
     "Design",
@@ -41,6 +42,7 @@ __all__ = [
     "Unit",
     "chosen_lrs",
     "covers",
+    "diagnostic_unit",
     "network_of",
     "plan_units",
 ]
@@ -93,6 +95,7 @@ class Design:
     aim: BoxNoise = AIM
     limit_s: float = LIMIT_S
     map_spacing: int = 1  # the full map: every reachable cell
+    diagnostics: tuple[str, ...] = ()  # units that train nothing: COVISIBILITY
 
     def __post_init__(self) -> None:
         names = [r.method for r in self.rows]
@@ -228,6 +231,11 @@ def _evaluation(design: Design, row: Row, seed: int) -> Evaluation:
     return Evaluation(row.method, noise=noise, full_map=row.full_map and extras)
 
 
+def diagnostic_unit(name: str) -> Unit:
+    """The unit of a diagnostic (one per dataset: no seed, no training)."""
+    return Unit(name, 0, None, None, (), network=False)
+
+
 def plan_units(design: Design, records: dict[str, dict[str, Any]]) -> Plan:
     """Every unit of ``design`` in the order they should run (choices first), split into those
     ``records`` (by unit name) hold and those still to run; units that wait on a choice are
@@ -246,6 +254,7 @@ def plan_units(design: Design, records: dict[str, dict[str, Any]]) -> Plan:
             networks[network] = [r for r in design.rows if network_of(r.method) == network]
             specs = [r.method for r in networks[network]]
             units += [_seed_zero(design, network, lr, specs) for lr in design.lrs]
+    units += [diagnostic_unit(name) for name in design.diagnostics]
     later: list[Unit] = []
     for network, rows in networks.items():
         chosen = chosen_lrs(design, network, records)
@@ -290,6 +299,9 @@ def _curve_rows(design: Design, rows: list[Row]) -> list[Row]:
     return [r for r in rows if r.method in design.curve_methods]
 
 
+# The covisibility oracle (seannet.evaluation.covisibility_oracle): how many test triplets
+# the views can decide at all; a diagnostic unit, no method
+COVISIBILITY = "covisibility-oracle"
 SEANNET = "seannet-fc512"  # SeanNet as the cpu preset trains it (the paper's fc: `seannet`)
 # The headline: SeanNet, the strongest simple baseline (resnet18+boxes) and every baseline the
 # leaderboard holds; SeanNet and the strongest baseline on 5 seeds, the rest on 3.
@@ -313,4 +325,5 @@ DESIGN = Design(
     rows=HEADLINE + FC + ABLATIONS,
     curve_methods=CURVE_METHODS,
     curve=((150.0, 3), (600.0, 3), (1200.0, 1)),
+    diagnostics=(COVISIBILITY,),
 )

@@ -19,31 +19,36 @@ from typing import Any
 
 import numpy as np
 
+from seannet.evaluation.covisibility_oracle import DIRECTIONS
 from seannet.evaluation.intervals import (
     per_room_matrix,
     t_interval,
     two_level_difference,
     welch_difference,
+    wilson_interval,
 )
 from seannet.methods.benchmark import summarize
 from seannet.methods.cards import leaderboard_rows
 from seannet.protocol.curve_plot import draw_curve
 from seannet.protocol.design import (
     ABLATIONS,
+    COVISIBILITY,
     FC,
     PROTOCOL_VERSION,
     Design,
     Plan,
     Unit,
     chosen_lrs,
+    diagnostic_unit,
     network_of,
     plan_units,
 )
 from seannet.protocol.records import Found
-from sgdata.fileio import atomic_write_text, save_png
+from sgdata.fileio import atomic_write_bytes, atomic_write_text, save_png
 
 __all__ = ["Records", "write_docs"]
 
+CONTACT_SHEET = "images/covisibility-disagreements.png"  # under the docs folder
 CURVE_BASE_SEEDS = 3  # the curve's seeds at the design's own budget (its other budgets: design)
 
 
@@ -386,6 +391,63 @@ def strongest_baseline(r: Records, methods: Sequence[str]) -> str | None:
     return max(complete, key=lambda m: float(np.mean([x["val_accuracy"] for x in r.runs(m)])))
 
 
+def _covisibility(r: Records, baseline: str | None) -> list[str]:
+    """The covisibility oracle per tier and direction beside the thumbnail, the first row and
+    the strongest baseline (each triplet's outcome from their records, mean over seeds), the
+    share of triplets covisibility disagrees with, and the contact sheet."""
+    record = r.found.units.get(diagnostic_unit(COVISIBILITY).name)
+    if record is None:
+        return ["Not measured yet (the `covisibility-oracle` unit)."]
+    o = record["results"][COVISIBILITY]
+    methods = [m for m in dict.fromkeys(("tiny-image", r.first, baseline)) if m and r.runs(m)]
+    outcomes = {m: np.array([[c == "1" for c in x["test_correct"]] for x in r.runs(m)
+                             if "test_correct" in x], dtype=float).mean(axis=0)
+                for m in methods}  # fmt: skip
+    tiers = np.array([int(t) for t in o["tier"]])
+    directions = np.array(list(o["direction"]))
+    right = np.array([c == "1" for c in o["correct"]])
+    rows = []
+    cells = [(t, d) for t in sorted(set(tiers)) for d in DIRECTIONS
+             if ((tiers == t) & (directions == d)).any()]  # fmt: skip
+    for t, d in [*cells, (None, None)]:
+        mask = np.ones(len(tiers), bool) if t is None else (tiers == t) & (directions == d)
+        w = wilson_interval(int(right[mask].sum()), int(mask.sum()))
+        rows.append([
+            "all" if t is None else str(t), "" if d is None else DIRECTIONS[d], str(w["n"]),
+            _span(w, sign=False), f"{100 * (1 - w['mean']):.1f}",
+            *(_pct(float(outcomes[m][mask].mean())) for m in methods),
+        ])  # fmt: skip
+    header = ["tier", "positive's step", "triplets", "oracle % (Wilson 95 %)",
+              "covisibility disagrees %", *(f"`{m}` %" for m in methods)]  # fmt: skip
+    overall = o["accuracy"]
+    distance = [
+        f"- `{m}` on all test triplets: {_pct(float(outcomes[m].mean()))} %, "
+        f"{100 * (overall - float(outcomes[m].mean())):+.1f} points to the oracle's "
+        f"{_pct(overall)} %."
+        for m in methods if m != "tiny-image"
+    ]  # fmt: skip
+    return [
+        'The oracle answers "the positive" when covisibility(anchor, positive) > '
+        "covisibility(anchor, negative): the share of each view's pixels whose 3D point the "
+        "other sees (depth rendered from the rooms, depth-consistent within 5 %, symmetric; "
+        "`sgdata/render/covisibility.py`). Where it disagrees with the label, the label's "
+        "metric order (k cells against k + 1) is not what the views share: an appearance-only "
+        "method can only decide such a triplet by other cues. It reads poses and geometry, so "
+        "it is a diagnostic, not a method. Models: each triplet's outcome from their records, "
+        "mean over seeds.",
+        "",
+        *_table(header, rows),
+        "",
+        *distance,
+        "",
+        f"![triplets where covisibility disagrees with the label]({CONTACT_SHEET})",
+        "",
+        f"{len(o['disagreements'])} of the {o['triplets'] - int(right.sum())} triplets where "
+        "covisibility disagrees with the label (anchor, positive, negative), spread evenly "
+        "over them.",
+    ]
+
+
 def results_doc(r: Records) -> str:
     design = r.design
     # the headline: every row but the fc's and the ablations', in the design's order
@@ -422,6 +484,10 @@ def results_doc(r: Records) -> str:
         "### By cascade tier (tier 0: same pose, another layout, against one step; %)",
         "",
         *_tier_table(r, shown),
+        "",
+        "## What the views can decide: the covisibility oracle",
+        "",
+        *_covisibility(r, baseline),
         "",
         "## Under labeler / detector box noise",
         "",
@@ -597,6 +663,11 @@ def write_docs(r: Records, out: Path) -> list[Path]:
     if points:
         save_png(draw_curve(points), out / "learning-curve.png")
         written.append(out / "learning-curve.png")
+    diagnostic = r.found.units.get(diagnostic_unit(COVISIBILITY).name)
+    if diagnostic is not None:  # the record's contact sheet, where the doc shows it
+        sheet = r.found.folder / diagnostic["results"][COVISIBILITY]["contact_sheet"]
+        atomic_write_bytes(out / CONTACT_SHEET, sheet.read_bytes())
+        written.append(out / CONTACT_SHEET)
     for name, text in (
         ("results.md", results_doc(r)),
         ("learning-curve.md", curve_doc(r, "learning-curve.png")),

@@ -20,7 +20,7 @@ from seannet.data.opening import open_dataset
 from seannet.methods.benchmark import BenchmarkConfig, run_seed
 from seannet.methods.cards import method_label
 from seannet.methods.registry import load_method
-from seannet.protocol.design import Design, Evaluation, Unit
+from seannet.protocol.design import COVISIBILITY, Design, Evaluation, Unit
 from seannet.protocol.records import (
     CALIBRATION,
     dataset_identity,
@@ -29,6 +29,7 @@ from seannet.protocol.records import (
     write_record,
 )
 from sgdata.dataset import Dataset
+from sgdata.fileio import save_png
 
 __all__ = ["budget_batches", "calibration_name", "run_unit"]
 
@@ -92,6 +93,8 @@ def run_unit(
     wall, cpu = time.perf_counter(), time.process_time()
     shutil.rmtree(work, ignore_errors=True)
     ds = open_dataset(data)
+    if unit.trains == COVISIBILITY:
+        return _diagnostic(unit, ds, folder, started, where, wall, cpu, say)
     batches, calibration = None, None
     if unit.network:
         assert unit.budget_s is not None
@@ -216,3 +219,66 @@ def _full_map(
         },  # fmt: skip
         "seconds": round(time.perf_counter() - clock, 1),
     }
+
+
+def _diagnostic(
+    unit: Unit,
+    ds: Dataset,
+    folder: Path,
+    started: dict[str, Any],
+    where: dict[str, Any],
+    wall: float,
+    cpu: float,
+    say: Callable[[str], None],
+) -> Path:
+    """The covisibility oracle on the test triplets, its record, and beside it the contact
+    sheet of triplets where covisibility disagrees with the label."""
+    from seannet.evaluation.covisibility_oracle import oracle
+
+    result = oracle(ds, "test", say)
+    sheet = folder / f"{unit.name}.png"
+    save_png(contact_sheet(ds, result["disagreements"]), sheet)
+    record = {
+        "unit": unit.name,
+        **unit.to_dict(),
+        "dataset": dataset_identity(ds),
+        "provenance": started,
+        "machine": where,
+        "seconds": {
+            "wall": round(time.perf_counter() - wall, 1),
+            "cpu": round(time.process_time() - cpu, 1),
+        },
+        "results": {COVISIBILITY: {**result, "contact_sheet": sheet.name}},
+    }
+    return write_record(folder, unit.name, record)
+
+
+def contact_sheet(ds: Dataset, triplets: list[dict[str, Any]], size: int = 112) -> Any:
+    """Anchor, positive and negative of each triplet side by side, two triplets a row, each
+    captioned with its tier, direction and both covisibilities."""
+    from PIL import Image, ImageDraw, ImageFont
+
+    from sgdata.dataset import decode_image
+
+    wanted = {t[k] for t in triplets for k in ("anchor", "positive", "negative")}
+    table = ds.observations("test", columns=["obs_id", "image"]).to_pylist()
+    images = {r["obs_id"]: decode_image(r["image"]) for r in table if r["obs_id"] in wanted}
+    caption, per_row = 16, 2
+    rows = max(1, -(-len(triplets) // per_row))
+    sheet = Image.new("RGB", (per_row * 3 * size + (per_row - 1) * 8, rows * (size + caption)),
+                      "white")  # fmt: skip
+    draw, font = ImageDraw.Draw(sheet), ImageFont.load_default(size=11)
+    for k, t in enumerate(triplets):
+        x0 = (k % per_row) * (3 * size + 8)
+        y0 = (k // per_row) * (size + caption)
+        for j, role in enumerate(("anchor", "positive", "negative")):
+            thumb = Image.fromarray(images[t[role]]).resize((size, size))
+            sheet.paste(thumb, (x0 + j * size, y0 + caption))
+        draw.text(
+            (x0 + 2, y0 + 2),
+            f"tier {t['tier']} {t['direction']}: cov A-P {t['anchor_positive']:.2f}, "
+            f"A-N {t['anchor_negative']:.2f}",
+            fill="black",
+            font=font,
+        )
+    return sheet

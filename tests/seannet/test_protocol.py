@@ -6,6 +6,7 @@ limit is refused with its estimate."""
 from __future__ import annotations
 
 import json
+import math
 import os
 import shutil
 import signal
@@ -17,20 +18,22 @@ from pathlib import Path
 import pytest
 
 from seannet.data.box_noise import BoxNoise
-from seannet.protocol.design import AIM, Design, Row, plan_units
+from seannet.evaluation.covisibility_oracle import step_direction
+from seannet.protocol.design import AIM, COVISIBILITY, Design, Row, diagnostic_unit, plan_units
 from seannet.protocol.docs import Records, write_docs
 from seannet.protocol.records import find_folder, read_records
 from seannet.protocol.runner import plan_text, run_for, status
 from tests.artefacts import shared_artefact
 from tests.cli_runner import run_cli
 
-# 4 units: tiny-image (no training), resnet18 at each lr with seed 0, then the chosen lr's
-# seed 1; one batch of one epoch, so a unit takes seconds
+# 5 units: resnet18 at each lr with seed 0, tiny-image (no training), the covisibility
+# oracle, then the chosen lr's seed 1; one batch of one epoch, so a unit takes seconds
 TINY = Design(
     rows=(Row("resnet18+boxes", seeds=2, noise=True), Row("tiny-image", seeds=1)),
     batches=1,
     epochs=1,
     noise_grid=(BoxNoise(jitter=0.05), AIM),
+    diagnostics=(COVISIBILITY,),
 )
 DOCS = ("results.md", "learning-curve.md", "leaderboard.md")
 
@@ -46,7 +49,7 @@ def protocol_records(tmp_path_factory: pytest.TempPathFactory, mini_dataset: Pat
 
     def build(root: Path) -> None:
         written = run_for(TINY, mini_dataset, root, root.parent / "protocol-work")
-        assert len(written) == 4
+        assert len(written) == 5
 
     return shared_artefact(tmp_path_factory, "protocol_records", build)
 
@@ -103,14 +106,14 @@ def test_an_interrupted_protocol_gives_the_docs_of_one_run(
     protocol_records: Path, mini_dataset: Path, tmp_path: Path
 ) -> None:
     whole = _docs(protocol_records, tmp_path / "whole")
-    assert "**Complete**: all 4 units" in whole["results.md"]
+    assert "**Complete**: all 5 units" in whole["results.md"]
     records = tmp_path / "records"
     first = run_for(TINY, mini_dataset, records, tmp_path / "work", units=2)
     assert len(first) == 2
     part = _docs(records, tmp_path / "part")
-    assert "**2 of 4 units measured**" in part["results.md"]
+    assert "**2 of 5 units measured**" in part["results.md"]
     second = run_for(TINY, mini_dataset, records, tmp_path / "work")
-    assert len(second) == 2
+    assert len(second) == 3
     assert _docs(records, tmp_path / "again") == whole
 
 
@@ -124,7 +127,7 @@ def test_a_doc_of_one_unit_says_so_and_leaves_the_others_cells_empty(
         if path.stem != "tiny-image-s0":
             path.unlink()
     text = _docs(records, tmp_path / "docs")["results.md"]
-    assert "**1 of 4 units measured**" in text
+    assert "**1 of 5 units measured**" in text
     row = next(line for line in text.splitlines() if line.startswith("| `resnet18+boxes` | 0 of 2"))
     assert row.replace(" ", "").endswith("|" * 9)  # every figure cell empty
     assert "| `tiny-image` | 1 |" in text
@@ -229,7 +232,7 @@ def test_the_results_commands_plan_and_refuse_bad_input(
 def test_records_are_small_and_name_what_made_them(protocol_records: Path) -> None:
     folder = next(p for p in protocol_records.iterdir() if p.is_dir())
     found = read_records(folder, find_folder(protocol_records, None).recipe)
-    assert len(found.units) == 4 and not found.left_out
+    assert len(found.units) == 5 and not found.left_out
     for name, record in found.units.items():
         size = (folder / f"{name}.json").stat().st_size
         assert size < 64_000, f"{name}: {size} bytes"
@@ -239,3 +242,32 @@ def test_records_are_small_and_name_what_made_them(protocol_records: Path) -> No
     trained = found.units["resnet18-b300-lr0.01-s0"]
     assert trained["training"]["batches_per_epoch"] == 1
     assert trained["training"]["calibration"] == {"handed_in": 1}
+
+
+def test_step_direction_reads_the_step_against_the_anchors_heading() -> None:
+    east = (1.0, 1.0, 0.0)  # heading +x
+    assert step_direction(east, (1.0, 1.0)) == "s"
+    assert step_direction(east, (1.5, 1.0)) == "a" and step_direction(east, (0.5, 1.0)) == "a"
+    assert step_direction(east, (1.0, 1.75)) == "c"
+    assert step_direction(east, (1.25, 1.5)) == "m"
+    north = (1.0, 1.0, math.pi / 2)
+    assert step_direction(north, (1.0, 1.75)) == "a" and step_direction(north, (1.5, 1.0)) == "c"
+
+
+def test_the_covisibility_oracle_is_recorded_and_shown_beside_the_methods(
+    protocol_records: Path, tmp_path: Path
+) -> None:
+    found = find_folder(protocol_records, None)
+    oracle = found.units[diagnostic_unit(COVISIBILITY).name]["results"][COVISIBILITY]
+    n = oracle["triplets"]
+    assert len(oracle["tier"]) == len(oracle["direction"]) == len(oracle["correct"]) == n > 0
+    for tier, direction in zip(oracle["tier"], oracle["direction"], strict=True):
+        # tier 0's positive is the anchor's own cell in another layout; every other tier moves
+        assert (direction == "s") == (tier == "0"), (tier, direction)
+    assert oracle["accuracy"] > 0.5  # the views decide more triplets than a coin would
+    docs = tmp_path / "docs"
+    text = _docs(protocol_records, docs)["results.md"]
+    section = text.split("## What the views can decide")[1].split("\n## ")[0]
+    assert "| all |  | " + str(n) + " | " in section
+    assert "`tiny-image` %" in section and "`resnet18+boxes` %" in section
+    assert (docs / "images" / "covisibility-disagreements.png").is_file()
