@@ -26,29 +26,23 @@ import argparse
 import json
 import os
 import shutil
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "bench"))
-
-from render import rate, sample_poses  # noqa: E402  (bench/render.py)
-
-from sgdata.annotate.annotator import ViewAnnotator  # noqa: E402
-from sgdata.annotate.slots import SlotTable  # noqa: E402
-from sgdata.render.renderer import Renderer  # noqa: E402
-from sgdata.usd.geometry import read_geometry  # noqa: E402
-from sgdata.usd.room_io import catalog_geometry, write_room  # noqa: E402
-from sgdata.world.appearance import AppearanceConfig  # noqa: E402
-from sgdata.world.catalog import Catalog, load_catalog  # noqa: E402
-from sgdata.world.mesh_assets import class_assets  # noqa: E402
-from sgdata.world.rooms import generate_room  # noqa: E402
-from sgdata.world.scene import Room  # noqa: E402
+from sgdata.annotate.annotator import ViewAnnotator
+from sgdata.annotate.slots import SlotTable
+from sgdata.bench import sample_poses, views_per_second
+from sgdata.render.renderer import Renderer
+from sgdata.usd.geometry import read_geometry
+from sgdata.usd.room_io import catalog_geometry, write_room
+from sgdata.world.appearance import AppearanceConfig
+from sgdata.world.catalog import Catalog, load_catalog
+from sgdata.world.mesh_assets import class_assets
+from sgdata.world.rooms import generate_room
+from sgdata.world.scene import Room
 
 MESH_OBJECTS = 30
 
@@ -140,7 +134,7 @@ def main() -> None:
             ("view", lambda p: annotator.view(p)),
         ):
             cpu = time.process_time()
-            fps[label][key].append(rate(fn, poses))
+            fps[label][key].append(views_per_second(fn, poses))
             fps[label][f"{key}_cpu"].append(len(poses) / (time.process_time() - cpu))
     renderer.close()
 

@@ -20,8 +20,6 @@ from __future__ import annotations
 import argparse
 import json
 import tempfile
-import time
-from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -29,10 +27,10 @@ import numpy as np
 from sgdata.annotate.annotator import ViewAnnotator
 from sgdata.annotate.records import ViewPose
 from sgdata.annotate.slots import SlotTable
+from sgdata.bench import sample_poses, views_per_second
 from sgdata.render.camera import CameraConfig
 from sgdata.render.renderer import Renderer
 from sgdata.usd.meshes import SceneGeometry
-from sgdata.world.poses import pose_grid
 from sgdata.world.scene import Room
 
 
@@ -55,20 +53,6 @@ def generated_scenes(n: int, seed: int) -> list[tuple[Room, SceneGeometry]]:
         usd_io.write_room(room, path, geometry=geometry, appearance=AppearanceConfig())
         out.append((room, read_geometry(path)))
     return out
-
-
-def sample_poses(room: Room, count: int, rng: np.random.Generator) -> list[ViewPose]:
-    grid = pose_grid(room)
-    if not grid.cells:
-        return []
-    picks = rng.integers(0, len(grid.cells), count)
-    poses = []
-    for p in picks:
-        i, j = grid.cells[int(p)]
-        h = int(rng.integers(0, 4))
-        x, y, th = grid.pose_world(i, j, h)
-        poses.append(ViewPose(x, y, th, i, j, h))
-    return poses
 
 
 class NaivePyrender:
@@ -123,14 +107,6 @@ class NaivePyrender:
         return rgb, ids
 
 
-def rate(fn: Callable[[ViewPose], object], poses: list[ViewPose]) -> float:
-    fn(poses[0])  # warm-up: shader compilation, buffer upload
-    t = time.perf_counter()
-    for p in poses:
-        fn(p)
-    return len(poses) / (time.perf_counter() - t)
-
-
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--rooms", type=int, default=1, help="generated rooms to bench")
@@ -171,21 +147,25 @@ def main() -> None:
             continue
         draw(False)
         fps = {
-            "rgb": rate(lambda p: renderer.render_rgb(p.x, p.y, p.theta), poses),
-            "ids": rate(lambda p: renderer.render_ids(p.x, p.y, p.theta), poses),
-            "rgb+ids": rate(lambda p: renderer.render(p.x, p.y, p.theta), poses),
+            "rgb": views_per_second(lambda p: renderer.render_rgb(p.x, p.y, p.theta), poses),
+            "ids": views_per_second(lambda p: renderer.render_ids(p.x, p.y, p.theta), poses),
+            "rgb+ids": views_per_second(lambda p: renderer.render(p.x, p.y, p.theta), poses),
         }
         runs: dict[str, list[float]] = {"pipeline": [], "pipeline_textured": []}
         for textured in (False, True, False, True):  # ABAB: load changes hit both alike
             draw(textured)
             key = "pipeline_textured" if textured else "pipeline"
-            runs[key].append(rate(lambda p: annotator.view(p), poses))
-        fps["rgb_textured"] = rate(lambda p: renderer.render_rgb(p.x, p.y, p.theta), poses)
+            runs[key].append(views_per_second(lambda p: annotator.view(p), poses))
+        fps["rgb_textured"] = views_per_second(
+            lambda p: renderer.render_rgb(p.x, p.y, p.theta), poses
+        )
         fps.update({k: float(np.mean(v)) for k, v in runs.items()})
         naive_runs: dict[str, list[float]] = {"naive": [], "naive_textured": []}
         for textured in (False, True, False, True):
             naive.load(geometry, textured=textured)
-            naive_runs["naive_textured" if textured else "naive"].append(rate(naive.view, poses))
+            naive_runs["naive_textured" if textured else "naive"].append(
+                views_per_second(naive.view, poses)
+            )
         fps.update({k: float(np.mean(v)) for k, v in naive_runs.items()})
         for key, value in fps.items():
             totals[key].append(value)
