@@ -77,6 +77,7 @@ class Row:
     seeds: int = 3
     noise: bool = False  # the box-noise grid on one seed, the aim's point on every seed
     full_map: bool = False  # recall among every sub-node of a test room's map, one seed
+    stage: int = 0  # run order: every unit of stage 0 before any of stage 1 (the headline first)
 
 
 @dataclass(frozen=True)
@@ -276,7 +277,19 @@ def plan_units(design: Design, records: dict[str, dict[str, Any]]) -> Plan:
                 for seed in range(seeds):
                     evaluations = tuple(Evaluation(r.method) for r in curve)
                     later.append(Unit(network, seed, budget, lr, evaluations))
-    for unit in units + later:
+    # by stage (the headline before the fc and the ablations), the curve's other budgets last;
+    # within a stage every row's first seed before any row's second (a partial doc has each
+    # row early), then the rows' order; a diagnostic runs with the first seeds
+    rank = {r.method: (r.stage, k) for k, r in enumerate(design.rows)}
+    for network, rows in networks.items():
+        rank[network] = min(rank[r.method] for r in rows)
+    ranked = sorted(
+        units + later,
+        key=lambda u: (u.budget_s not in (None, design.budget_s),
+                       rank.get(u.trains, (0, len(rank)))[0], u.seed,
+                       rank.get(u.trains, (0, len(rank)))[1]),
+    )  # fmt: skip
+    for unit in ranked:
         done = unit.name in records and covers(records[unit.name], unit)
         (plan.done if done else plan.todo).append(unit)
     return plan
@@ -317,8 +330,12 @@ HEADLINE = (
     Row("tiny-image", seeds=1),
     Row("boxes-kernel", seeds=3),
 )
-FC = (Row("seannet", seeds=3),)  # the paper's GCN fc, 4,096 wide, against fc512
-ABLATIONS = (Row("seannet-image"), Row("seannet-nolayout"), Row("seannet-graph"))
+FC = (Row("seannet", seeds=3, stage=1),)  # the paper's GCN fc, 4,096 wide, against fc512
+ABLATIONS = (
+    Row("seannet-image", stage=1),
+    Row("seannet-nolayout", stage=1),
+    Row("seannet-graph", stage=1),
+)
 CURVE_METHODS = (SEANNET, "resnet18+boxes", f"{SEANNET}+box-kernel")
 
 DESIGN = Design(
