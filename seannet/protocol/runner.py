@@ -17,6 +17,7 @@ from typing import Any
 
 from seannet.data.opening import open_dataset
 from seannet.protocol.design import Design, Plan, Unit, plan_units
+from seannet.protocol.docs import Records, write_docs  # at start: the code a long run began with
 from seannet.protocol.records import Found, dataset_identity, read_records, recipe_folder
 from seannet.protocol.unit import run_unit
 
@@ -188,6 +189,4 @@ def run_for(
 
 
 def _write_docs(design: Design, data: Path, records: Path, out: Path) -> None:
-    from seannet.protocol.docs import Records, write_docs
-
     write_docs(Records(design, status(design, data, records).found), out)
