@@ -35,6 +35,7 @@ from seannet.protocol.design import (
     COVISIBILITY,
     FC,
     PROTOCOL_VERSION,
+    SEANNET,
     Design,
     Plan,
     Unit,
@@ -459,9 +460,13 @@ def results_doc(r: Records) -> str:
     out = _header(
         r,
         "Results: SeanNet against the strongest simple baselines",
-        f"Every row is measured against the first, `{r.first}` (SeanNet as the `cpu` preset "
-        "trains it, `seannet-fc512`, in the project's design; the paper's GCN fc, 4,096 wide, is "
-        "`seannet`: its section below).",
+        f"Every row is measured against the first, `{r.first}`"
+        + (
+            ": SeanNet as the `cpu` preset trains it (the paper's GCN fc, 4,096 wide, is "
+            "`seannet`: its section below)."
+            if r.first == SEANNET
+            else "."
+        ),
     )
     out += ["## Aims", "", *_aims(r, baseline, losses, recall), ""]
     out += [
@@ -473,7 +478,7 @@ def results_doc(r: Records) -> str:
         "",
         *_table(HEADLINE_HEADER, [_row_cells(r, m) for m in shown]),
         "",
-        "### SeanNet minus each",
+        f"### {r.first} minus each",
         "",
         *_differences(r, r.first, [m for m in shown if m != r.first]),
         "",
@@ -544,8 +549,7 @@ def results_doc(r: Records) -> str:
         "",
         "[learning-curve.md](learning-curve.md) holds the curve's tables.",
         "",
-        "![accuracy against budget](learning-curve.png)",
-        "",
+        *(["![accuracy against budget](learning-curve.png)", ""] if curve_points(r) else []),
         "## Not measured by this protocol",
         "",
         "- Navigation with each network as localizer (docs/navigation.md has its own runs).",
@@ -607,7 +611,8 @@ def curve_doc(r: Records, plot: str) -> str:
         f"{r.design.budget_s:g} s bought, scaled by the budget (no second timing), at the lr "
         f"val chose at {r.design.budget_s:g} s. Intervals: 95 % t over seeds.",
     )
-    out += [f"![accuracy against budget]({plot})", ""]
+    if points:
+        out += [f"![accuracy against budget]({plot})", ""]
     budgets = sorted([(r.design.budget_s, CURVE_BASE_SEEDS), *r.design.curve])
     for method in r.design.curve_methods:
         have = {p["budget_s"]: p for p in points.get(method, [])}
@@ -660,14 +665,19 @@ def write_docs(r: Records, out: Path) -> list[Path]:
     out.mkdir(parents=True, exist_ok=True)
     written = []
     points = curve_points(r)
+    plot = out / "learning-curve.png"
     if points:
-        save_png(draw_curve(points), out / "learning-curve.png")
-        written.append(out / "learning-curve.png")
+        save_png(draw_curve(points), plot)
+        written.append(plot)
+    else:  # a plot of other records would be a stale figure
+        plot.unlink(missing_ok=True)
     diagnostic = r.found.units.get(diagnostic_unit(COVISIBILITY).name)
     if diagnostic is not None:  # the record's contact sheet, where the doc shows it
         sheet = r.found.folder / diagnostic["results"][COVISIBILITY]["contact_sheet"]
         atomic_write_bytes(out / CONTACT_SHEET, sheet.read_bytes())
         written.append(out / CONTACT_SHEET)
+    else:
+        (out / CONTACT_SHEET).unlink(missing_ok=True)
     for name, text in (
         ("results.md", results_doc(r)),
         ("learning-curve.md", curve_doc(r, "learning-curve.png")),
