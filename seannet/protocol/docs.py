@@ -421,6 +421,11 @@ def _covisibility(r: Records, baseline: str | None) -> list[str]:
     header = ["tier", "positive's step", "triplets", "oracle % (Wilson 95 %)",
               "covisibility disagrees %", *(f"`{m}` %" for m in methods)]  # fmt: skip
     overall = o["accuracy"]
+    decidable = [
+        [f"`{m}`", _pct(float(outcomes[m].mean())), _pct(float(outcomes[m][right].mean())),
+         _pct(float(outcomes[m][~right].mean())) if (~right).any() else ""]
+        for m in methods
+    ]  # fmt: skip
     distance = [
         f"- `{m}` on all test triplets: {_pct(float(outcomes[m].mean()))} %, "
         f"{100 * (overall - float(outcomes[m].mean())):+.1f} points to the oracle's "
@@ -440,6 +445,12 @@ def _covisibility(r: Records, baseline: str | None) -> list[str]:
         *_table(header, rows),
         "",
         *distance,
+        "",
+        "Accuracy on the triplets the views decide (covisibility agrees with the label: "
+        f"{int(right.sum())} of {len(right)}) beside the paper's, all triplets, and on the "
+        "others:",
+        "",
+        *_table(["model", "all %", "decidable %", "not decidable %"], decidable),
         "",
         f"![triplets where covisibility disagrees with the label]({CONTACT_SHEET})",
         "",
