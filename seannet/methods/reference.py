@@ -23,7 +23,6 @@ from torch import Tensor, nn
 from seannet.evaluation.box_kernel import BoxKernel
 from seannet.evaluation.scene_term import BOX_KERNEL, SceneTerm
 from seannet.methods.boxes import box_scores, box_vectors, row_triplets, vector_boxes
-from seannet.methods.registry import register_method
 from seannet.methods.views import Budget, SplitData, Views
 from seannet.model.loss import TripletLoss
 from seannet.weights import LITE0, LITE0_WEIGHTS
@@ -41,7 +40,6 @@ __all__ = [
 ]
 
 
-@register_method("tiny-image")
 class TinyImage:
     """The view as 16 x 16 x 3 pixels, mean removed, compared by cosine."""
 
@@ -53,7 +51,6 @@ class TinyImage:
         return x - x.mean(dim=1, keepdim=True)
 
 
-@register_method("lite0-gem")
 class Lite0GeM:
     """Frozen ImageNet EfficientNet-Lite0, GeM pooling of its last map (1280-d)."""
 
@@ -78,7 +75,6 @@ class Lite0GeM:
         return features.pow(self.p).mean(dim=(2, 3)).pow(1.0 / self.p)
 
 
-@register_method("lite0-gem-head")
 class Lite0GeMHead(Lite0GeM):
     """Frozen Lite0 + GeM, then a linear head trained on the train triplets (triplet loss,
     margin 0.1, SGD with momentum; the lr of ``budget.lrs`` best on val, default 0.01 / 0.1)."""
@@ -183,7 +179,6 @@ class NetVLAD(nn.Module):
         return F.normalize(F.normalize(residual, dim=2).flatten(1), dim=1)
 
 
-@register_method("lite0-netvlad")
 class Lite0NetVLAD(Lite0GeMHead):
     """Frozen Lite0, then NetVLAD (64 channels, 16 clusters: 1,024-d) trained on the train
     triplets like ``lite0-gem-head``'s head (triplet loss, the lr of ``budget.lrs`` best on val).
@@ -203,7 +198,6 @@ class Lite0NetVLAD(Lite0GeMHead):
         return self.head(self.features(views))
 
 
-@register_method("boxes-overlap")
 class BoxOverlap:
     """Boxes only: each slot's box (image-relative), scored by the mean IoU over the slots
     present in either view (the scene term ``+boxes`` alone:
@@ -235,7 +229,6 @@ class BoxOverlap:
         return box_scores(a, b, self.scene).float()  # float32, as the cards were computed
 
 
-@register_method("boxes-kernel")
 class BoxKernelMethod(BoxOverlap):
     """Boxes only, scored by a per-slot weighted IoU learned on the train triplets
     (the scene term ``+box-kernel`` alone: :mod:`seannet.evaluation.box_kernel`)."""

@@ -25,6 +25,16 @@ __all__ = [
 ]
 
 ENTRY_POINT_GROUP = "seannet.methods"
+# The reference methods, by import path: the registry names them, the module that defines
+# them never imports the registry (no circle, dynamic imports included)
+REFERENCE = {
+    "tiny-image": "seannet.methods.reference:TinyImage",
+    "lite0-gem": "seannet.methods.reference:Lite0GeM",
+    "lite0-gem-head": "seannet.methods.reference:Lite0GeMHead",
+    "lite0-netvlad": "seannet.methods.reference:Lite0NetVLAD",
+    "boxes-overlap": "seannet.methods.reference:BoxOverlap",
+    "boxes-kernel": "seannet.methods.reference:BoxKernelMethod",
+}
 _REGISTERED: dict[str, Callable[[], Any]] = {}
 
 
@@ -63,16 +73,13 @@ def register_method(name: str) -> Callable[[Callable[[], Any]], Callable[[], Any
     from seannet.model.specs import MODEL_NAMES
 
     def decorate(factory: Callable[[], Any]) -> Callable[[], Any]:
-        if name in MODEL_NAMES or (name in _REGISTERED and _REGISTERED[name] is not factory):
+        taken = name in MODEL_NAMES or name in REFERENCE
+        if taken or (name in _REGISTERED and _REGISTERED[name] is not factory):
             raise MethodError(f"method {name!r}: the name is taken; register it under another")
         _REGISTERED[name] = factory
         return factory
 
     return decorate
-
-
-def _reference() -> None:
-    importlib.import_module("seannet.methods.reference")  # registers the reference methods
 
 
 def _entry_points() -> dict[str, Any]:
@@ -83,8 +90,8 @@ def method_names() -> list[str]:
     """Every method a name reaches: the registered ones, the entry points, the model names."""
     from seannet.model.specs import MODEL_NAMES
 
-    _reference()
-    return [*_REGISTERED, *(n for n in _entry_points() if n not in _REGISTERED), *MODEL_NAMES]
+    named = [*REFERENCE, *_REGISTERED]
+    return [*named, *(n for n in _entry_points() if n not in named), *MODEL_NAMES]
 
 
 def _from_path(target: str) -> Callable[[], Any]:
@@ -118,10 +125,11 @@ def load_method(name: str) -> tuple[Callable[[], Any], bool]:
     Raises:
         MethodError: nothing of that name; the message lists what there is.
     """
-    _reference()
     try:
         if ":" in name:
             return _from_path(name), False
+        if name in REFERENCE:
+            return _from_path(REFERENCE[name]), False
         if name in _REGISTERED:
             return _REGISTERED[name], False
         found = _entry_points()
@@ -138,7 +146,7 @@ def load_method(name: str) -> tuple[Callable[[], Any], bool]:
     except ModelError:
         raise MethodError(
             f"method {name!r}: not registered, no entry point, no import path (pkg.mod:make) and "
-            f"no model spec; registered: {', '.join(_REGISTERED)}"
+            f"no model spec; registered: {', '.join([*REFERENCE, *_REGISTERED])}"
         ) from None
     from seannet.methods.bundled import NetworkMethod
 

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -21,196 +20,37 @@ import numpy as np
 
 from seannet.evaluation.covisibility_oracle import DIRECTIONS
 from seannet.evaluation.intervals import (
-    per_room_matrix,
-    t_interval,
-    two_level_difference,
-    welch_difference,
     wilson_interval,
 )
 from seannet.methods.benchmark import summarize
 from seannet.methods.cards import leaderboard_rows
-from seannet.protocol.curve_plot import draw_curve
+from seannet.protocol.curve import curve_doc, curve_points, draw_curve
 from seannet.protocol.design import (
     ABLATIONS,
     COVISIBILITY,
     FC,
-    PROTOCOL_VERSION,
     SEANNET,
-    Design,
-    Plan,
-    Unit,
-    chosen_lrs,
     diagnostic_unit,
-    network_of,
-    plan_units,
 )
-from seannet.protocol.records import Found
+from seannet.protocol.reading import (
+    Records,
+    difference,
+    header,
+    pct,
+    pm,
+    seeds_cell,
+    span,
+    table,
+    verdict,
+)
 from sgdata.fileio import atomic_write_bytes, atomic_write_text, save_png
 
-__all__ = ["Records", "write_docs"]
+__all__ = ["Records", "leaderboard_doc", "results_doc", "write_docs"]
 
 CONTACT_SHEET = "images/covisibility-disagreements.png"  # under the docs folder
-CURVE_BASE_SEEDS = 3  # the curve's seeds at the design's own budget (its other budgets: design)
-
-
-@dataclass
-class Records:
-    """The records of one recipe, read through the design: each method's runs at its chosen
-    lr, per budget."""
-
-    design: Design
-    found: Found
-
-    def __post_init__(self) -> None:
-        self.plan: Plan = plan_units(self.design, self.found.units)
-        self._lrs: dict[str, dict[str, float] | None] = {}
-        self.first = self.design.rows[0].method  # every other row is measured against it
-
-    def lr(self, method: str) -> float | None:
-        """The lr val chose for a model spec (None: not chosen yet, or not a network)."""
-        network = network_of(method)
-        if network is None:
-            return None
-        if network not in self._lrs:
-            self._lrs[network] = chosen_lrs(self.design, network, self.found.units)
-        chosen = self._lrs[network]
-        return None if chosen is None else chosen[method]
-
-    def unit_records(self, method: str, budget: float | None = None) -> list[dict[str, Any]]:
-        """The records of ``method``'s seeds at ``budget`` (default: the design's) at its
-        chosen lr, seed order, those recorded only."""
-        if method not in {r.method for r in self.design.rows}:
-            return []
-        row = self.design.row(method)
-        network = network_of(method)
-        if network is None:
-            names = [Unit(method, s, None, None, (), False).name for s in range(row.seeds)]
-        else:
-            lr = self.lr(method)
-            if lr is None:
-                return []
-            budget = self.design.budget_s if budget is None else budget
-            names = [
-                Unit(network, s, budget, lr, ()).name for s in range(self.seeds(method, budget))
-            ]
-        return [self.found.units[n] for n in names if method in self.found.units.get(n, {}).get(
-            "results", {})]  # fmt: skip
-
-    def seeds(self, method: str, budget: float | None = None) -> int:
-        """Seeds the design asks of ``method`` at ``budget``."""
-        if budget is None or budget == self.design.budget_s:
-            return self.design.row(method).seeds
-        return dict(self.design.curve)[budget]
-
-    def runs(self, method: str, budget: float | None = None) -> list[dict[str, Any]]:
-        """``method``'s per-seed results (the benchmark harness's) at its chosen lr."""
-        return [r["results"][method] for r in self.unit_records(method, budget)]
-
-
-# ------------------------------------------------------------------------------ cells
-
-
-def _pct(x: float | None) -> str:
-    return "" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{100 * x:.1f}"
-
-
-def _pm(entry: dict[str, float]) -> str:
-    half = entry.get("ci95", float("nan"))
-    return _pct(entry["mean"]) + ("" if math.isnan(half) else f" ± {_pct(half)}")
-
-
-def _span(entry: dict[str, float], sign: bool = True) -> str:
-    if math.isnan(entry.get("low", float("nan"))):
-        return f"{100 * entry['mean']:+.1f}" if sign else _pct(entry["mean"])
-    f = (lambda x: f"{100 * x:+.1f}") if sign else (lambda x: f"{100 * x:.1f}")
-    return f"{f(entry['mean'])} [{f(entry['low'])}, {f(entry['high'])}]"
-
-
-def _table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> list[str]:
-    return [
-        "| " + " | ".join(header) + " |",
-        "|" + "---|" * len(header),
-        *("| " + " | ".join(r) + " |" for r in rows),
-    ]
-
-
-def _seeds_cell(got: int, asked: int) -> str:
-    return str(got) if got == asked else f"{got} of {asked}"
-
-
-def _weight(runs: list[dict[str, Any]]) -> tuple[list[str], np.ndarray]:
-    rooms = sorted(runs[0]["per_room"])
-    return rooms, np.array([runs[0]["room_triplets"][r] for r in rooms], dtype=np.float64)
-
-
-def _difference(a: list[dict[str, Any]], b: list[dict[str, Any]]) -> dict[str, Any]:
-    """A minus B on the same rooms: two-level (paired on rooms) and Welch over seeds."""
-    rooms, weight = _weight(a)
-    return {
-        "rooms_seeds": two_level_difference(
-            per_room_matrix(a, rooms), per_room_matrix(b, rooms), weight
-        ),
-        "seeds": welch_difference([r["accuracy"] for r in a], [r["accuracy"] for r in b]),
-    }
-
-
-def _verdict(d: dict[str, float], first: str) -> str:
-    if d["low"] > 0:
-        return f"{first} is above it"
-    if d["high"] < 0:
-        return f"{first} is below it"
-    return "the two are not apart (the interval holds 0)"
 
 
 # ------------------------------------------------------------------------------ results.md
-
-
-def _header(r: Records, title: str, what: str) -> list[str]:
-    """Title, the status (complete, or k of N units), the protocol and the stamp."""
-    plan, found, design = r.plan, r.found, r.design
-    total = f"{plan.total}{'+' if plan.open_ended else ''}"
-    if not plan.todo and not plan.pending:
-        state = f"**Complete**: all {plan.total} units of the protocol are recorded."
-    else:
-        state = (
-            f"**{len(plan.done)} of {total} units measured**: empty cells wait on the others "
-            "(`seannet results plan` lists them; `seannet results run --for 50m` runs them)."
-        )
-    identity = next(iter(found.units.values()), {}).get("dataset", {})
-    commits = ", ".join(
-        f"`{c[:10]}`" + (" (with uncommitted changes)" if d else "") for c, d in found.commits
-    )
-    shas = ", ".join(f"`{s[:16]}…`" for s in found.content_sha256s)
-    lines = [
-        f"# {title}",
-        "",
-        f"Written by `seannet results doc` from the records of `{found.folder.name}` alone "
-        f"(a folder of `results/records/`); no figure is typed. {what}",
-        "",
-        state,
-        "",
-        f"- Protocol version {PROTOCOL_VERSION}: every training run gets {design.budget_s:g} s of "
-        "one thread's compute (batches per epoch from one calibration per network, recorded); "
-        "each network's lr chosen on val with seed 0 from "
-        f"{{{', '.join(f'{lr:g}' for lr in design.lrs)}}} (per method spec, ties: the smaller), "
-        "its other seeds at that lr; every choice of a method (epsilon, lambda, a kernel) on "
-        "val; test read once per run, and shown at the chosen lr only.",
-    ]
-    if identity:
-        lines.append(
-            f"- Dataset `{identity['name']}`, seed {identity['seed']}, format "
-            f"{identity['format_version']}, recipe `{found.recipe[:16]}…`; content sha256 of "
-            f"the records: {shas}."
-        )
-    if commits:
-        lines.append(f"- Records made at commit {commits}.")
-    if found.left_out:
-        lines.append(
-            f"- Left out: {len(found.left_out)} file(s) of the folder: "
-            + "; ".join(found.left_out)
-            + "."
-        )
-    return [*lines, ""]
 
 
 def _row_cells(r: Records, method: str) -> list[str]:
@@ -230,14 +70,14 @@ def _row_cells(r: Records, method: str) -> list[str]:
     )
     return [
         f"`{method}`",
-        _seeds_cell(len(runs), asked),
+        seeds_cell(len(runs), asked),
         "" if lr is None else f"{lr:g}",
-        _pct(float(np.mean([x["val_accuracy"] for x in runs]))),
-        _pm(s["accuracy"]),
-        _span(s["accuracy_rooms_seeds"], sign=False),
-        _pct(s["recall1"]["mean"]),
-        _pct(s["per_tier"].get("0")),
-        _pct(s["per_tier"].get("1")),
+        pct(float(np.mean([x["val_accuracy"] for x in runs]))),
+        pm(s["accuracy"]),
+        span(s["accuracy_rooms_seeds"], sign=False),
+        pct(s["recall1"]["mean"]),
+        pct(s["per_tier"].get("0")),
+        pct(s["per_tier"].get("1")),
         got,
     ]
 
@@ -258,13 +98,13 @@ def _differences(r: Records, first: str, others: Sequence[str]) -> list[str]:
         if not a or not b:
             rows.append([f"`{other}`", "", "", ""])
             continue
-        d = _difference(a, b)
+        d = difference(a, b)
         rows.append([
-            f"`{other}`", _span(d["rooms_seeds"]), _span(d["seeds"]),
-            _verdict(d["rooms_seeds"], first) if not math.isnan(d["rooms_seeds"]["low"]) else "",
+            f"`{other}`", span(d["rooms_seeds"]), span(d["seeds"]),
+            verdict(d["rooms_seeds"], first) if not math.isnan(d["rooms_seeds"]["low"]) else "",
         ])  # fmt: skip
     header = ["model", f"{first} minus it, rooms x seeds 95 % (points)", "seeds, Welch", "reading"]
-    return _table(header, rows)
+    return table(header, rows)
 
 
 def _moved_table(r: Records, methods: Sequence[str]) -> list[str]:
@@ -275,10 +115,10 @@ def _moved_table(r: Records, methods: Sequence[str]) -> list[str]:
             continue
         change = summarize(runs)["change"]["moved_objects"]
         bins = bins or list(change)
-        rows.append([f"`{m}`", *(_pct(change[b]["accuracy"]) for b in bins)])
+        rows.append([f"`{m}`", *(pct(change[b]["accuracy"]) for b in bins)])
     if bins is None:
         return ["Not measured yet."]
-    return _table(["model", *(f"{b} moved" for b in bins)], rows)
+    return table(["model", *(f"{b} moved" for b in bins)], rows)
 
 
 def _tier_table(r: Records, methods: Sequence[str]) -> list[str]:
@@ -289,10 +129,10 @@ def _tier_table(r: Records, methods: Sequence[str]) -> list[str]:
             continue
         per_tier = summarize(runs)["per_tier"]
         tiers = tiers or sorted(per_tier, key=int)
-        rows.append([f"`{m}`", *(_pct(per_tier.get(t)) for t in tiers)])
+        rows.append([f"`{m}`", *(pct(per_tier.get(t)) for t in tiers)])
     if tiers is None:
         return ["Not measured yet."]
-    return _table(["model", *(f"tier {t}" for t in tiers)], rows)
+    return table(["model", *(f"tier {t}" for t in tiers)], rows)
 
 
 def _noise_levels(run: dict[str, Any]) -> dict[str, float]:
@@ -312,17 +152,15 @@ def _noise_table(r: Records) -> tuple[list[str], dict[str, float | None]]:
         at_aim = [(x["accuracy"], _noise_levels(x)[aim]) for x in runs if aim in _noise_levels(x)]
         loss = float(np.mean([c - n for c, n in at_aim])) if at_aim else None
         losses[row.method] = loss
-        cells = [_pct(grid.get(label)) for label in labels if label != aim]
+        cells = [pct(grid.get(label)) for label in labels if label != aim]
         aim_cell = (
-            f"{_pct(float(np.mean([n for _, n in at_aim])))} ({len(at_aim)} seeds)"
-            if at_aim
-            else ""
+            f"{pct(float(np.mean([n for _, n in at_aim])))} ({len(at_aim)} seeds)" if at_aim else ""
         )
         loss_cell = "" if loss is None else f"{100 * loss:.1f}"
         rows.append([f"`{row.method}`", *cells, aim_cell, loss_cell])
     header = ["model", *(label for label in labels if label != aim), f"{aim} (aim)",
               "loss at the aim, points"]  # fmt: skip
-    return _table(header, rows), losses
+    return table(header, rows), losses
 
 
 def _full_map_table(r: Records) -> tuple[list[str], dict[str, float]]:
@@ -334,11 +172,11 @@ def _full_map_table(r: Records) -> tuple[list[str], dict[str, float]]:
             continue
         f = found[0]
         recall[row.method] = f["recall@1"]
-        by = " / ".join(f"{b}: {_pct(v['recall@1'])}" for b, v in f["by_moved"].items())
+        by = " / ".join(f"{b}: {pct(v['recall@1'])}" for b, v in f["by_moved"].items())
         rows.append([f"`{row.method}`", str(f["rooms"]), str(f["queries"]),
-                     _pct(f["recall@1"]), _pct(f["recall@5"]), by])  # fmt: skip
+                     pct(f["recall@1"]), pct(f["recall@5"]), by])  # fmt: skip
     header = ["model", "rooms", "queries", "recall@1 %", "recall@5 %", "recall@1 by moved in view"]
-    return _table(header, rows), recall
+    return table(header, rows), recall
 
 
 def _budget_table(r: Records) -> list[str]:
@@ -355,7 +193,7 @@ def _budget_table(r: Records) -> list[str]:
         return ["No calibration recorded yet."]
     header = ["network", "budget (s)", "batches / epoch", "step (s)", "rounds apart", "clock",
               "timed on", "record"]  # fmt: skip
-    return _table(header, rows)
+    return table(header, rows)
 
 
 def _aims(r: Records, baseline: str | None, losses: dict[str, float | None],
@@ -364,12 +202,12 @@ def _aims(r: Records, baseline: str | None, losses: dict[str, float | None],
     ours = r.runs(first)
     rows = []
     mean = summarize(ours)["accuracy"]["mean"] if ours else None
-    rows.append([f"{first} >= 90 %", _pct(mean), "" if mean is None else
+    rows.append([f"{first} >= 90 %", pct(mean), "" if mean is None else
                  ("yes" if mean >= 0.9 else "no")])  # fmt: skip
     if baseline and ours and r.runs(baseline):
-        d = _difference(ours, r.runs(baseline))["rooms_seeds"]
+        d = difference(ours, r.runs(baseline))["rooms_seeds"]
         met = "yes" if d["mean"] >= 0.03 and d["low"] > 0 else "no"
-        rows.append([f">= +3 points over {baseline}, interval clear of 0", _span(d), met])
+        rows.append([f">= +3 points over {baseline}, interval clear of 0", span(d), met])
     else:
         rows.append([">= +3 points over the strongest baseline, interval clear of 0", "", ""])
     loss = losses.get(first)
@@ -377,9 +215,9 @@ def _aims(r: Records, baseline: str | None, losses: dict[str, float | None],
                  "" if loss is None else f"{100 * loss:.1f} points",
                  "" if loss is None else ("yes" if loss <= 0.03 else "no")])  # fmt: skip
     got = recall.get(first)
-    rows.append(["full-map recall@1 >= 90 %", _pct(got),
+    rows.append(["full-map recall@1 >= 90 %", pct(got),
                  "" if got is None else ("yes" if got >= 0.9 else "no")])  # fmt: skip
-    return _table(["aim", "measured", "met"], rows)
+    return table(["aim", "measured", "met"], rows)
 
 
 def strongest_baseline(r: Records, methods: Sequence[str]) -> str | None:
@@ -415,21 +253,21 @@ def _covisibility(r: Records, baseline: str | None) -> list[str]:
         w = wilson_interval(int(right[mask].sum()), int(mask.sum()))
         rows.append([
             "all" if t is None else str(t), "" if d is None else DIRECTIONS[d], str(w["n"]),
-            _span(w, sign=False), f"{100 * (1 - w['mean']):.1f}",
-            *(_pct(float(outcomes[m][mask].mean())) for m in methods),
+            span(w, sign=False), f"{100 * (1 - w['mean']):.1f}",
+            *(pct(float(outcomes[m][mask].mean())) for m in methods),
         ])  # fmt: skip
     header = ["tier", "positive's step", "triplets", "oracle % (Wilson 95 %)",
               "covisibility disagrees %", *(f"`{m}` %" for m in methods)]  # fmt: skip
     overall = o["accuracy"]
     decidable = [
-        [f"`{m}`", _pct(float(outcomes[m].mean())), _pct(float(outcomes[m][right].mean())),
-         _pct(float(outcomes[m][~right].mean())) if (~right).any() else ""]
+        [f"`{m}`", pct(float(outcomes[m].mean())), pct(float(outcomes[m][right].mean())),
+         pct(float(outcomes[m][~right].mean())) if (~right).any() else ""]
         for m in methods
     ]  # fmt: skip
     distance = [
-        f"- `{m}` on all test triplets: {_pct(float(outcomes[m].mean()))} %, "
+        f"- `{m}` on all test triplets: {pct(float(outcomes[m].mean()))} %, "
         f"{100 * (overall - float(outcomes[m].mean())):+.1f} points to the oracle's "
-        f"{_pct(overall)} %."
+        f"{pct(overall)} %."
         for m in methods if m != "tiny-image"
     ]  # fmt: skip
     return [
@@ -442,7 +280,7 @@ def _covisibility(r: Records, baseline: str | None) -> list[str]:
         "it is a diagnostic, not a method. Models: each triplet's outcome from their records, "
         "mean over seeds.",
         "",
-        *_table(header, rows),
+        *table(header, rows),
         "",
         *distance,
         "",
@@ -450,7 +288,7 @@ def _covisibility(r: Records, baseline: str | None) -> list[str]:
         f"{int(right.sum())} of {len(right)}) beside the paper's, all triplets, and on the "
         "others:",
         "",
-        *_table(["model", "all %", "decidable %", "not decidable %"], decidable),
+        *table(["model", "all %", "decidable %", "not decidable %"], decidable),
         "",
         f"![triplets where covisibility disagrees with the label]({CONTACT_SHEET})",
         "",
@@ -468,7 +306,7 @@ def results_doc(r: Records) -> str:
     baseline = strongest_baseline(r, shown)
     noise, losses = _noise_table(r)
     full_map, recall = _full_map_table(r)
-    out = _header(
+    out = header(
         r,
         "Results: SeanNet against the strongest simple baselines",
         f"Every row is measured against the first, `{r.first}`"
@@ -487,7 +325,7 @@ def results_doc(r: Records) -> str:
         f"{f'`{baseline}`' if baseline else 'not known yet'}. Intervals: seeds t (95 %) and "
         "rooms x seeds (a room bootstrap's variance plus the seeds', t on seeds - 1 dof).",
         "",
-        *_table(HEADLINE_HEADER, [_row_cells(r, m) for m in shown]),
+        *table(HEADLINE_HEADER, [_row_cells(r, m) for m in shown]),
         "",
         f"### {r.first} minus each",
         "",
@@ -529,7 +367,7 @@ def results_doc(r: Records) -> str:
             "",
             "## The paper's GCN fc (4,096 wide) against fc512",
             "",
-            *_table(HEADLINE_HEADER, [_row_cells(r, m) for m in [r.first, *fc]]),
+            *table(HEADLINE_HEADER, [_row_cells(r, m) for m in [r.first, *fc]]),
             "",
             *_differences(r, r.first, fc),
         ]
@@ -543,7 +381,7 @@ def results_doc(r: Records) -> str:
             "branch (GCN pathways, no layout pathway); `seannet-graph`: no image vector in the "
             "fusion. The same budget and selection as every row.",
             "",
-            *_table(HEADLINE_HEADER, [_row_cells(r, m) for m in [fc[0], *ablations]]),
+            *table(HEADLINE_HEADER, [_row_cells(r, m) for m in [fc[0], *ablations]]),
             "",
             *_differences(r, fc[0], ablations),
         ]
@@ -570,86 +408,6 @@ def results_doc(r: Records) -> str:
     return "\n".join(out)
 
 
-# ------------------------------------------------------------------------------ the curve
-
-
-def curve_points(r: Records) -> dict[str, list[dict[str, Any]]]:
-    """Per curve method, one point per budget with records: seeds, val and test intervals,
-    what the budget bought; budgets ascending."""
-    budgets = sorted([(r.design.budget_s, CURVE_BASE_SEEDS), *r.design.curve])
-    points: dict[str, list[dict[str, Any]]] = {}
-    for method in r.design.curve_methods:
-        for budget, seeds in budgets:
-            records = r.unit_records(method, budget)[:seeds]
-            if not records:
-                continue
-            runs = [x["results"][method] for x in records]
-            points.setdefault(method, []).append({
-                "budget_s": budget, "seeds": len(runs), "asked": seeds,
-                "lr": records[0]["lr"], "training": records[0]["training"],
-                "val": t_interval([x["val_accuracy"] for x in runs]),
-                "test": t_interval([x["accuracy"] for x in runs]),
-            })  # fmt: skip
-    return points
-
-
-def _cell(interval: dict[str, float]) -> str:
-    if interval["n"] < 2:
-        return f"{100 * interval['mean']:.1f} (1 seed)"
-    return f"{100 * interval['mean']:.1f} ± {100 * interval['ci95']:.1f}"
-
-
-def _flattens(points: list[dict[str, Any]]) -> str:
-    """Where val accuracy stops gaining a point per budget step (read on val, not test)."""
-    if len(points) < 2:
-        return "One budget only so far."
-    pairs = list(zip(points, points[1:], strict=False))
-    gains = [100 * (b["val"]["mean"] - a["val"]["mean"]) for a, b in pairs]
-    steps = "; ".join(f"{a['budget_s']:g} to {b['budget_s']:g} s: {g:+.1f}"
-                      for (a, b), g in zip(pairs, gains, strict=True))  # fmt: skip
-    for (a, _), g in zip(pairs, gains, strict=True):
-        if g < 1.0:
-            return f"Flat from {a['budget_s']:g} s (val gains, points: {steps})."
-    return f"Still rising at {points[-1]['budget_s']:g} s (val gains, points: {steps})."
-
-
-def curve_doc(r: Records, plot: str) -> str:
-    points = curve_points(r)
-    out = _header(
-        r,
-        "Learning curve: accuracy against the training budget",
-        "Each budget trains a network the batches its calibration at "
-        f"{r.design.budget_s:g} s bought, scaled by the budget (no second timing), at the lr "
-        f"val chose at {r.design.budget_s:g} s. Intervals: 95 % t over seeds.",
-    )
-    if points:
-        out += [f"![accuracy against budget]({plot})", ""]
-    budgets = sorted([(r.design.budget_s, CURVE_BASE_SEEDS), *r.design.curve])
-    for method in r.design.curve_methods:
-        have = {p["budget_s"]: p for p in points.get(method, [])}
-        rows = []
-        for budget, seeds in budgets:
-            p = have.get(budget)
-            if p is None:
-                rows.append([f"{budget:g}", f"0 of {seeds}", "", "", "", ""])
-                continue
-            t = p["training"]
-            rows.append([
-                f"{budget:g}", _seeds_cell(p["seeds"], seeds),
-                f"{t['batches_per_epoch']} x {t['epochs']}" if t.get("batches_per_epoch") else "",
-                f"{p['lr']:g}", _cell(p["val"]), _cell(p["test"]),
-            ])  # fmt: skip
-        out += [
-            f"## `{method}`",
-            "",
-            _flattens(points.get(method, [])),
-            "",
-            *_table(["budget (s)", "seeds", "batches x epochs", "lr", "val %", "test %"], rows),
-            "",
-        ]
-    return "\n".join(out)
-
-
 # ------------------------------------------------------------------------------ leaderboard
 
 
@@ -660,7 +418,7 @@ def leaderboard_doc(r: Records) -> str:
         if runs:
             cards.append({"method": row.method, "trained": runs[0]["trained"],
                           "summary": summarize(runs)})  # fmt: skip
-    out = _header(
+    out = header(
         r,
         "Leaderboard",
         "Every method of the protocol under the benchmark's measures (`seannet benchmark`), "

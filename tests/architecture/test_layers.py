@@ -5,6 +5,7 @@ may, and the reading side loads no USD, renderer or torch."""
 from __future__ import annotations
 
 import ast
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -46,17 +47,39 @@ LIVE_VIEWS_MAY_IMPORT = ("sgdata.render", "sgdata.usd", "sgdata.annotate", "sgda
 HEAVY = ("pxr", "pyrender", "open3d", "trimesh", "torch", "OpenGL", "sgdata.render", "sgdata.usd")
 
 
-def _imports(path: Path, package: str = "sgdata") -> set[str]:
+def _imports(path: Path, package: str = "sgdata", *, dynamic: bool = False) -> set[str]:
     """Every ``package`` module a file imports: at module level, inside functions and under
-    ``if TYPE_CHECKING:`` (a circle of types is still a circle for a reader)."""
+    ``if TYPE_CHECKING:`` (a circle of types is still a circle for a reader); with
+    ``dynamic``, also the modules it imports at run time: a literal handed to
+    ``import_module``, and in a file that calls ``import_module`` itself, every import path
+    ``"pkg.module:name"`` it holds (a registry resolving its own table; a record that only
+    names a builder another module resolves is data, not an import)."""
     found = set()
     tree = ast.parse(path.read_text(encoding="utf-8"))
+    resolves = dynamic and any(
+        isinstance(n, ast.Call) and _called(n) == "import_module" for n in ast.walk(tree)
+    )
     for node in ast.walk(tree):
         if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
             found.add(node.module)
         elif isinstance(node, ast.Import):
             found.update(a.name for a in node.names)
+        elif resolves and isinstance(node, ast.Constant) and isinstance(node.value, str):
+            if IMPORT_PATH.fullmatch(node.value):
+                found.add(node.value.partition(":")[0])
+        elif dynamic and isinstance(node, ast.Call) and _called(node) == "import_module":
+            first = node.args[0] if node.args else None
+            if isinstance(first, ast.Constant) and isinstance(first.value, str):
+                found.add(first.value)
     return {m for m in found if m == package or m.startswith(package + ".")}
+
+
+IMPORT_PATH = re.compile(r"[a-z_][a-z0-9_]*(\.[a-z_][a-z0-9_]*)+(:[A-Za-z_]\w*)?")
+
+
+def _called(node: ast.Call) -> str:
+    f = node.func
+    return f.attr if isinstance(f, ast.Attribute) else f.id if isinstance(f, ast.Name) else ""
 
 
 def _stage(module: str) -> str | None:
@@ -97,12 +120,31 @@ def test_world_and_render_never_import_each_other_and_dataset_needs_no_usd() -> 
 
 @pytest.mark.parametrize("package", ["sgdata", "seannet"])
 def test_no_import_cycle(package: str) -> None:
-    """No cycle among a package's modules, counting imports inside functions: a circle
-    closed by a deferred import is still a circle (each module needs the others)."""
-    names = {m for m, _ in _modules(package)}
+    """No cycle among a package's modules, counting imports inside functions and dynamic
+    ones: a circle closed by a deferred or a run-time import is still a circle (each module
+    needs the others)."""
+    _assert_no_cycle(_modules(package), package)
+
+
+def test_a_circle_closed_by_a_dynamic_import_is_found(tmp_path: Path) -> None:
+    """A registry that imports its entries by name, and an entry that imports the registry:
+    no ``import`` statement closes the circle, the check still sees it."""
+    (tmp_path / "registry.py").write_text(
+        'import importlib\nTABLE = {"a": "pkg.entry:Thing"}\n'
+        'def load():\n    importlib.import_module("pkg.entry")\n'
+    )
+    (tmp_path / "entry.py").write_text("from pkg.registry import TABLE\n")
+    modules = [("pkg.registry", tmp_path / "registry.py"), ("pkg.entry", tmp_path / "entry.py")]
+    with pytest.raises(pytest.fail.Exception, match="pkg.entry -> pkg.registry"):
+        _assert_no_cycle(modules, "pkg")
+
+
+def _assert_no_cycle(modules: list[tuple[str, Path]], package: str) -> None:
+    names = {m for m, _ in modules}
     graph: dict[str, set[str]] = {}
-    for module, path in _modules(package):
-        graph[module] = {_owner(t, names) for t in _imports(path, package)} - {module, None}
+    for module, path in modules:
+        edges = {_owner(t, names) for t in _imports(path, package, dynamic=True)}
+        graph[module] = edges - {module, None}
     state: dict[str, int] = {}
 
     def visit(node: str, trail: list[str]) -> None:
