@@ -10,7 +10,6 @@ use, the CLI help and docs the table). Nothing downloads.
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -160,19 +159,3 @@ def network_table() -> str:
         norm = "ImageNet mean / std" if r.mean == IMAGENET_MEAN else "(x - 127) / 128"
         rows.append(f"| {name} | {norm} | {r.feature_width} | {c4} | {r.resolution} | {offline} |")
     return "\n".join(rows) + "\n"
-
-
-_RENAMED = {"WEIGHTS": "NETWORKS", "WeightsRecord": "NetworkRecord"}
-
-
-def __getattr__(name: str) -> Any:
-    if name in _RENAMED:
-        new = _RENAMED[name]
-        warnings.warn(
-            f"seannet.weights.{name} is now seannet.weights.{new}; the old name goes in the "
-            "next release",
-            DeprecationWarning,
-            stacklevel=2,
-        )
-        return globals()[new]
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

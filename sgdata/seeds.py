@@ -21,8 +21,6 @@ import hashlib
 
 import numpy as np
 
-from sgdata.deprecation import moved_names
-
 __all__ = [
     "derive_seed",
     "rng_for",
@@ -120,24 +118,3 @@ def texture_seed(kind: str, variant: int) -> int:
     """One procedural texture image, by its kind and variant only: every room and dataset
     shares the same images."""
     return derive_seed(name_key(_TEXTURES), name_key(kind), variant)
-
-
-# old names, served with a DeprecationWarning for one release
-_SEANNET = (
-    "init_seed",
-    "epoch_order_seed",
-    "epoch_dropout_seed",
-    "navigator_init_seed",
-    "navigator_pairs_seed",
-    "navigator_order_seed",
-    "navigator_jitter_seed",
-    "episode_seed",
-    "box_noise_seed",
-)
-__getattr__ = moved_names(
-    __name__,
-    {
-        "own_room_seed": "sgdata.seeds:user_room_seed",
-        **{name: f"seannet.seeds:{name}" for name in _SEANNET},  # the trainer's own seeds
-    },
-)

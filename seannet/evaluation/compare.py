@@ -460,18 +460,3 @@ def markdown(results: dict[str, Any]) -> str:
         moved = e["summary"]["by_moved"]
         rows.append(f"| {e['model']} | " + " | ".join(_pm(moved[b]) for b in bins) + " |")
     return "\n".join(rows) + "\n"
-
-
-def __getattr__(name: str) -> Any:
-    """``calibrate_batches`` moved to :mod:`seannet.training.budget` (one release)."""
-    if name == "calibrate_batches":
-        from seannet.training import budget
-
-        warnings.warn(
-            "seannet.evaluation.compare.calibrate_batches moved to "
-            "seannet.training.budget.calibrate_batches (the old name goes in the next release)",
-            DeprecationWarning,
-            stacklevel=2,
-        )
-        return budget.calibrate_batches
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

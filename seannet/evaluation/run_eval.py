@@ -1,8 +1,4 @@
-"""``seannet eval``: evaluate a run's best checkpoint and write JSON, markdown and heat maps.
-
-(Formerly ``seannet.evaluation.eval``, a name that shadowed the builtin and that tests renamed
-on import.)
-"""
+"""``seannet eval``: evaluate a run's best checkpoint and write JSON, markdown and heat maps."""
 
 from __future__ import annotations
 

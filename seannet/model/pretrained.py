@@ -9,10 +9,8 @@ weights for that architecture (the same check ``torch.hub`` makes with ``check_h
 from __future__ import annotations
 
 import re
-import warnings
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
 
 import torch
 from torch import Tensor, nn
@@ -133,21 +131,3 @@ def load_pretrained(
         )
     model.load_state_dict(state, strict=True)
     return model
-
-
-def _file_sha256(path: Path) -> str:
-    return sha256_file(path)[0]
-
-
-def __getattr__(name: str) -> Any:
-    """``file_sha256`` is ``sgdata.fileio.sha256_file(path)[0]`` (one home for hashing a file);
-    the old name is served for one release."""
-    if name == "file_sha256":
-        warnings.warn(
-            "seannet.model.pretrained.file_sha256 moved to sgdata.fileio.sha256_file "
-            "(use sha256_file(path)[0]; the old name goes in the next release)",
-            DeprecationWarning,
-            stacklevel=2,
-        )
-        return _file_sha256
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -22,7 +22,6 @@ import jsonschema
 from sgdata.annotate.relations import RelationType
 from sgdata.dataset.paths import CARD, CROISSANT, MANIFEST, SPLITS
 from sgdata.dataset.schema import FORMAT_VERSION, manifest_json_schema, migrate_manifest_dict
-from sgdata.deprecation import moved_names
 from sgdata.errors import DatasetError
 from sgdata.fileio import sha256_file
 
@@ -386,7 +385,3 @@ def parse_manifest(raw: bytes, path: Path) -> Manifest:
             "manifest generation writes"
         ) from None
     return Manifest.from_json(text, source=str(path))
-
-
-# old names, served with a DeprecationWarning for one release
-__getattr__ = moved_names(__name__, {"write_manifest": "sgdata.dataset.publish:write_manifest"})

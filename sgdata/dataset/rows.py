@@ -25,7 +25,6 @@ from sgdata.dataset.channels import encode_depth, encode_mask
 from sgdata.dataset.paths import SCENE_LAYER, obs_id
 from sgdata.dataset.schema import observations_schema, triplets_schema
 from sgdata.dataset.storage import file_table
-from sgdata.deprecation import moved_names
 from sgdata.errors import DatasetError
 from sgdata.fileio import atomic_file
 from sgdata.fileio import sha256_file as _sha256_file  # the bare name is the old one, below
@@ -335,7 +334,3 @@ def write_parquet(table: pa.Table, path: Path) -> ParquetInfo:
     except OSError as exc:
         raise DatasetError(f"{path}: cannot write here ({exc.strerror or exc})") from None
     return ParquetInfo(rows=table.num_rows, sha256=digest, bytes=size)
-
-
-# old names, served with a DeprecationWarning for one release
-__getattr__ = moved_names(__name__, {"sha256_file": "sgdata.fileio:sha256_file"})

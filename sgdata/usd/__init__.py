@@ -81,8 +81,5 @@ _EXPORTS = {
     "write_flattened": ".tagging",
 }
 
-# old names, still served (with a DeprecationWarning from their module) for one release
-_DEPRECATED = {"write_text_atomic": ".stage", "layout_path": ".scene_dirs"}
-
 __all__ = sorted(_EXPORTS)
-__getattr__, __dir__ = lazy_face(__name__, {**_EXPORTS, **_DEPRECATED})
+__getattr__, __dir__ = lazy_face(__name__, _EXPORTS)

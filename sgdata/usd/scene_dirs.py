@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from sgdata.deprecation import moved_names
 from sgdata.errors import ConfigError, SceneError
 from sgdata.fileio import prepare_output_dir
 from sgdata.scene_files import LAYOUT_FILE, ROOM_FILE, layout_file, room_file
@@ -169,7 +168,3 @@ def load_layout(room_dir: Path, index: int, catalog: Catalog | None = None) -> R
     if problems:
         raise SceneError(f"{path}: invalid layout: {problems[0]}")
     return room
-
-
-# old names, served with a DeprecationWarning for one release
-__getattr__ = moved_names(__name__, {"layout_path": "sgdata.usd.scene_dirs:layout_stage_file"})

@@ -13,7 +13,6 @@ from pathlib import Path
 
 from pxr import Sdf, Tf, Usd, UsdValidation
 
-from sgdata.deprecation import moved_names
 from sgdata.errors import UsdError, one_line
 from sgdata.fileio import atomic_write_text
 
@@ -143,7 +142,3 @@ def usd_reason(exc: Tf.ErrorException) -> str:
     except UnicodeDecodeError:  # pxr quotes the bad bytes of a corrupted file
         return "its text is not valid UTF-8 where USD stopped reading"
     return (text.split(" : ", 1)[-1] if " : " in text else text).strip("' ")
-
-
-# old names, served with a DeprecationWarning for one release
-__getattr__ = moved_names(__name__, {"write_text_atomic": "sgdata.usd.stage:write_usd_file"})

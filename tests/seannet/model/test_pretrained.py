@@ -111,11 +111,3 @@ def test_an_expected_sha256_that_cannot_be_used_is_refused(tmp_path: Path) -> No
         check_pretrained_request(tmp_path / "w.pth", "WRONG")
     check_pretrained_request(tmp_path / "w.pth", "ab" * 32)  # usable: no error
     check_pretrained_request(None, None)
-
-
-def test_file_sha256_is_sha256_file_under_its_old_name(tmp_path: Path) -> None:
-    path = tmp_path / "w.bin"
-    path.write_bytes(b"weights")
-    with pytest.warns(DeprecationWarning, match="sgdata.fileio.sha256_file"):
-        from seannet.model.pretrained import file_sha256
-    assert file_sha256(path) == sha256_file(path)[0]

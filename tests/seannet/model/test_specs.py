@@ -3,9 +3,6 @@ every list of names is read off the registry, and a bad spec names the choices."
 
 from __future__ import annotations
 
-import importlib
-import sys
-
 import pytest
 
 from seannet.errors import ModelError
@@ -80,22 +77,6 @@ def test_network_lookup_by_name_or_alias() -> None:
     with pytest.raises(ModelError, match="resnet18"):
         network("alexnet")
     assert set(SCENE_TERMS) == {"+boxes", "+box-kernel"}
-
-
-def test_old_names_import_with_a_deprecation_warning(monkeypatch: pytest.MonkeyPatch) -> None:
-    import seannet.weights as weights
-
-    with pytest.warns(DeprecationWarning, match="NETWORKS"):
-        assert weights.WEIGHTS is NETWORKS
-    with pytest.warns(DeprecationWarning, match="NetworkRecord"):
-        assert weights.WeightsRecord is weights.NetworkRecord
-    monkeypatch.delitem(sys.modules, "seannet.evaluation.eval", raising=False)
-    with pytest.warns(DeprecationWarning, match="run_eval"):
-        old = importlib.import_module("seannet.evaluation.eval")
-    from seannet.evaluation.run_eval import evaluate_run
-
-    assert old.evaluate_run is evaluate_run
-    assert old.SCENE_TERMS is SCENE_TERMS
 
 
 def test_the_docs_table_is_the_registry() -> None:

@@ -101,11 +101,3 @@ def test_budget_buys_batches(mini_dataset: Path) -> None:
 def test_a_budget_must_be_positive(mini_dataset: Path) -> None:
     with pytest.raises(ModelError, match="budget_s > 0"):
         calibrate(TINY, mini_dataset, 0.0)
-
-
-def test_the_old_home_still_imports_with_a_warning() -> None:
-    from seannet.evaluation import compare
-
-    with pytest.warns(DeprecationWarning, match="seannet.training.budget"):
-        old = compare.calibrate_batches
-    assert old is calibrate_batches
