@@ -1,20 +1,11 @@
-"""Markdown that seannet's commands and the bench scripts write: one table helper, one
-percent cell, so every generated document renders its figures the same way."""
+"""Markdown that seannet's commands and the bench scripts write: the table helper (sgdata's),
+one percent cell, so every generated document renders its figures the same way."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from sgdata.markdown import table  # the one table helper, sgdata's and seannet's
 
 __all__ = ["pct", "table"]
-
-
-def table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> list[str]:
-    """A GitHub markdown table, one line per row, every column left-aligned."""
-    return [
-        "| " + " | ".join(header) + " |",
-        "|" + "---|" * len(header),
-        *("| " + " | ".join(row) + " |" for row in rows),
-    ]
 
 
 def pct(share: float | None, digits: int = 1) -> str:

@@ -5,13 +5,14 @@ stamp)."""
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from seannet import markdown
 from seannet.evaluation.intervals import per_room_matrix, two_level_difference, welch_difference
+from seannet.markdown import table
 from seannet.protocol.design import (
     PROTOCOL_VERSION,
     Design,
@@ -84,7 +85,8 @@ class Records:
 
 
 def pct(x: float | None) -> str:
-    return "" if x is None or (isinstance(x, float) and math.isnan(x)) else f"{100 * x:.1f}"
+    """A share as a percent cell; empty for a figure not measured (never a dash or a zero)."""
+    return "" if x is None or (isinstance(x, float) and math.isnan(x)) else markdown.pct(x)
 
 
 def pm(entry: dict[str, float]) -> str:
@@ -97,14 +99,6 @@ def span(entry: dict[str, float], sign: bool = True) -> str:
         return f"{100 * entry['mean']:+.1f}" if sign else pct(entry["mean"])
     f = (lambda x: f"{100 * x:+.1f}") if sign else (lambda x: f"{100 * x:.1f}")
     return f"{f(entry['mean'])} [{f(entry['low'])}, {f(entry['high'])}]"
-
-
-def table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> list[str]:
-    return [
-        "| " + " | ".join(header) + " |",
-        "|" + "---|" * len(header),
-        *("| " + " | ".join(r) + " |" for r in rows),
-    ]
 
 
 def seeds_cell(got: int, asked: int) -> str:

@@ -35,6 +35,7 @@ SEANNET_MAY_IMPORT = (
     "sgdata.dataset",
     "sgdata.seeds",
     "sgdata.fileio",
+    "sgdata.markdown",  # the one markdown table helper
     "sgdata.errors",
     "sgdata.scene_files",
     "sgdata.lazy_face",
