@@ -21,7 +21,7 @@ from torch.utils.data import DataLoader
 from seannet.data.datasets import ImageTransform, TripletDataset, collate_triplets
 from seannet.model.loss import TripletLoss
 from seannet.seeds import init_seed
-from seannet.training.config import preset
+from seannet.training.config import DEFAULT_PRESET, preset
 from seannet.training.loop import train_one_epoch, triplet_step
 from seannet.training.runs import build_for_dataset
 from seannet.training.train import param_groups
@@ -41,7 +41,7 @@ PARTS = {
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("data", type=Path)
-    parser.add_argument("--preset", default="cpu")
+    parser.add_argument("--preset", default=DEFAULT_PRESET)
     parser.add_argument("--batches", type=int, default=8)
     parser.add_argument("--lr-scale", type=float, default=None)
     args = parser.parse_args()

@@ -21,6 +21,7 @@ import sys
 import tempfile
 from pathlib import Path
 
+from seannet.provenance import ProcessState
 from sgdata import markdown
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -56,9 +57,7 @@ def main() -> int:
     parser.add_argument("--surface", action="append", help="only these (repeatable)")
     parser.add_argument("--json", action="store_true", help="one JSON object per surface")
     args = parser.parse_args()
-    commit = subprocess.run(
-        ["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True, text=True
-    ).stdout.strip()
+    commit = ProcessState.capture(ROOT).commit[:7]
     reports = run_campaign(args.examples, args.seed, args.surface)
     if not reports:
         print("no surface ran: see pytest's output above (a --surface name it does not know?)")

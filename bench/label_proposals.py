@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import argparse
 import re
-import subprocess
 from pathlib import Path
 
+from seannet.provenance import ProcessState
 from sgdata.label.accuracy import score_proposals
 from sgdata.label.classes import load_class_names
 from sgdata.label.models import PhotoLabels
@@ -60,8 +60,7 @@ def main() -> None:
     if n != 1:
         raise SystemExit(f"{DOC}: expected one {BEGIN} ... {END} block")
     DOC.write_text(doc, encoding="utf-8")
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
-    print(f"wrote the table in {DOC} (at commit {commit.stdout.strip()})")
+    print(f"wrote the table in {DOC} (at commit {ProcessState.capture(ROOT).commit[:7]})")
 
 
 if __name__ == "__main__":

@@ -45,7 +45,7 @@ from seannet.model.loss import TripletLoss
 from seannet.model.seannet import SeanNet
 from seannet.protocol.design import DESIGN, network_of
 from seannet.training.budget import calibrate
-from seannet.training.config import TrainConfig, preset
+from seannet.training.config import DEFAULT_PRESET, TrainConfig, preset
 from seannet.training.loop import train_one_epoch, triplet_step
 from seannet.training.runs import build_for_dataset
 
@@ -68,7 +68,7 @@ def seconds_per_call(fn, calls: int) -> float:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("data", type=Path)
-    parser.add_argument("--preset", default="cpu")
+    parser.add_argument("--preset", default=DEFAULT_PRESET)
     parser.add_argument(
         "--models",
         type=lambda text: text.split(","),

@@ -14,7 +14,7 @@ from sgdata_cli.errors import run_app
 from seannet.model.config import BACKBONES
 from seannet.model.specs import MODEL_NAMES, spec_help
 from seannet.navigation.config import FUSIONS, MAP_SPACING, NavigationTestConfig, NavigatorConfig
-from seannet.training.config import PRESETS
+from seannet.training.config import DEFAULT_PRESET, PRESETS
 from sgdata.errors import SgdataError
 
 app = typer.Typer(
@@ -44,7 +44,7 @@ def train(
             + ")."
         ),
     ] = None,
-    preset: Annotated[str, typer.Option(help=f"One of {', '.join(PRESETS)}.")] = "cpu",
+    preset: Annotated[str, typer.Option(help=f"One of {', '.join(PRESETS)}.")] = DEFAULT_PRESET,
     backbone: Annotated[
         str | None, typer.Option(help=f"SeanNet's image network: {' | '.join(BACKBONES)}.")
     ] = None,
@@ -160,7 +160,7 @@ def compare(
             "seannet@lite0+imagenet"
         ),
     ] = "seannet,resnet18",
-    preset: Annotated[str, typer.Option(help=f"One of {', '.join(PRESETS)}.")] = "cpu",
+    preset: Annotated[str, typer.Option(help=f"One of {', '.join(PRESETS)}.")] = DEFAULT_PRESET,
     seeds: Annotated[str, typer.Option(help="Comma-separated training seeds.")] = "0",
     lrs: Annotated[
         str,
@@ -448,7 +448,7 @@ def benchmark(
     seeds: Annotated[str, typer.Option(help="Seeds of trained methods (frozen: the first).")] = (
         "0,1,2"
     ),
-    preset: Annotated[str, typer.Option(help=f"One of {', '.join(PRESETS)}.")] = "cpu",
+    preset: Annotated[str, typer.Option(help=f"One of {', '.join(PRESETS)}.")] = DEFAULT_PRESET,
     batches: Annotated[
         int | None, typer.Option(help="Batches per epoch for trained methods (default: preset).")
     ] = None,

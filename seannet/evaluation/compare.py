@@ -60,7 +60,7 @@ from seannet.evaluation.run_eval import evaluate_run
 from seannet.model.specs import parse_spec
 from seannet.provenance import PROCESS, provenance_record
 from seannet.training.budget import Calibration, calibrate
-from seannet.training.config import TrainConfig
+from seannet.training.config import DEFAULT_PRESET, TrainConfig
 from seannet.training.config import preset as load_preset
 from seannet.training.runs import LAST, device_for_run
 from seannet.training.train import train
@@ -113,7 +113,7 @@ def compare_models(
     out: Path,
     models: Sequence[str],
     *,
-    preset: str | TrainConfig = "cpu",
+    preset: str | TrainConfig = DEFAULT_PRESET,
     seeds: Sequence[int] = (0,),
     lrs: Sequence[float] = (),
     budget_s: float | None = None,

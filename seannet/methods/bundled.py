@@ -18,6 +18,7 @@ from seannet.evaluation.scene_term import SceneTerm
 from seannet.methods.boxes import box_scores, box_vectors, row_triplets, vector_boxes
 from seannet.methods.views import Budget, SplitData, Views
 from seannet.model.specs import SEANNET, parse_spec
+from seannet.training.config import DEFAULT_PRESET
 from seannet.training.config import preset as load_preset
 from seannet.training.runs import LAST, restore_run
 from seannet.training.train import train
@@ -50,7 +51,7 @@ class NetworkMethod:
 
     trainable = True
 
-    def __init__(self, spec: str, *, preset: str = "cpu") -> None:
+    def __init__(self, spec: str, *, preset: str = DEFAULT_PRESET) -> None:
         self.parsed = parse_spec(spec)
         self.name = spec
         self.uses_boxes = bool(self.parsed.scene) or (

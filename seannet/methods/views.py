@@ -12,6 +12,7 @@ from torch import Tensor
 
 from seannet.data.batch import SceneBatch
 from seannet.errors import MethodError
+from seannet.training.config import DEFAULT_PRESET
 
 __all__ = ["HIDDEN_FIELDS", "Budget", "SplitData", "Views"]
 
@@ -121,7 +122,7 @@ class Budget:
     """How much training a trainable method may do, and its seed."""
 
     seed: int = 0
-    preset: str = "cpu"  # the bundled networks' training preset (seannet.training.PRESETS)
+    preset: str = DEFAULT_PRESET  # the bundled networks' training preset (PRESETS)
     batches: int | None = None  # batches per epoch (None: the preset's)
     epochs: int | None = None  # epochs (None: the preset's)
     lrs: tuple[float, ...] = ()  # learning rates to choose from on val (empty: the preset's)

@@ -27,6 +27,7 @@ from typing import Any
 
 from seannet.data.box_noise import BoxNoise
 from seannet.errors import ModelError
+from seannet.training.config import DEFAULT_PRESET
 
 __all__ = [
     "AIM",
@@ -89,7 +90,7 @@ class Design:
     lrs: tuple[float, ...] = LRS
     curve_methods: tuple[str, ...] = ()  # measured again at each of ``curve``'s budgets
     curve: tuple[tuple[float, int], ...] = ()  # (budget seconds, seeds) besides budget_s
-    preset: str = "cpu"
+    preset: str = DEFAULT_PRESET
     batches: int | None = None  # batches per epoch at budget_s, handed in: no calibration
     epochs: int | None = None  # None: the preset's
     noise_grid: tuple[BoxNoise, ...] = NOISE_GRID

@@ -9,7 +9,7 @@ from typing import Any
 from seannet.errors import ModelError
 from seannet.model.config import MODEL_FIELDS, ModelConfig
 
-__all__ = ["PRESETS", "TrainConfig", "preset"]
+__all__ = ["DEFAULT_PRESET", "PRESETS", "TrainConfig", "preset"]
 
 
 @dataclass(frozen=True)
@@ -118,6 +118,10 @@ PRESETS: dict[str, TrainConfig] = {
         num_workers=12,
     ),
 }
+
+
+# The preset a command trains with when none is named: this project's machines have no GPU
+DEFAULT_PRESET = "cpu"
 
 
 def preset(name: str) -> TrainConfig:
