@@ -14,6 +14,7 @@ from sgdata_cli.errors import run_app
 from seannet.model.config import BACKBONES
 from seannet.model.specs import MODEL_NAMES, spec_help
 from seannet.navigation.config import FUSIONS, MAP_SPACING, NavigationTestConfig, NavigatorConfig
+from seannet.seeds import DEFAULT_SEEDS
 from seannet.training.config import DEFAULT_PRESET, PRESETS
 from sgdata.errors import SgdataError
 
@@ -446,7 +447,7 @@ def benchmark(
     ],
     out: Annotated[Path, typer.Option("--out", help="Directory for the cards (one per method).")],
     seeds: Annotated[str, typer.Option(help="Seeds of trained methods (frozen: the first).")] = (
-        "0,1,2"
+        ",".join(map(str, DEFAULT_SEEDS))
     ),
     preset: Annotated[str, typer.Option(help=f"One of {', '.join(PRESETS)}.")] = DEFAULT_PRESET,
     batches: Annotated[

@@ -18,6 +18,7 @@ from __future__ import annotations
 from sgdata.seeds import derive_seed, name_key
 
 __all__ = [
+    "DEFAULT_SEEDS",
     "init_seed",
     "epoch_order_seed",
     "epoch_dropout_seed",
@@ -29,6 +30,8 @@ __all__ = [
     "box_noise_seed",
 ]
 
+# The training seeds of a row when none are named (benchmark, compare): three, DESIGN §12's least
+DEFAULT_SEEDS = (0, 1, 2)
 _INIT = 1 << 20  # the initial weights (epochs use 0, 1, 2, ...)
 _NAVIGATOR = "navigator"  # the purpose key of the visual navigator's streams
 _JITTER = "jitter"  # the navigator's light jitter, under _NAVIGATOR

