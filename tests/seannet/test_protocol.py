@@ -19,7 +19,15 @@ import pytest
 
 from seannet.data.box_noise import BoxNoise
 from seannet.evaluation.covisibility_oracle import step_direction
-from seannet.protocol.design import AIM, COVISIBILITY, Design, Row, diagnostic_unit, plan_units
+from seannet.protocol.design import (
+    AIM,
+    COVISIBILITY,
+    DESIGN,
+    Design,
+    Row,
+    diagnostic_unit,
+    plan_units,
+)
 from seannet.protocol.docs import Records, write_docs
 from seannet.protocol.records import find_folder, read_records
 from seannet.protocol.runner import plan_text, run_for, status
@@ -271,3 +279,13 @@ def test_the_covisibility_oracle_is_recorded_and_shown_beside_the_methods(
     assert "| all |  | " + str(n) + " | " in section
     assert "`tiny-image` %" in section and "`resnet18+boxes` %" in section
     assert (docs / "images" / "covisibility-disagreements.png").is_file()
+
+
+def test_the_committed_docs_are_what_the_committed_records_say(tmp_path: Path) -> None:
+    root = Path(__file__).resolve().parents[2]
+    found = find_folder(root / "results" / "records", None)
+    write_docs(Records(DESIGN, found), tmp_path)
+    for name in DOCS:
+        assert (tmp_path / name).read_text() == (root / "docs" / name).read_text(), (
+            f"docs/{name} is not what the records say: run `seannet results doc`"
+        )
