@@ -1,6 +1,6 @@
 """A user's localization method for `seannet benchmark`: a colour histogram plus box overlap.
 
-seannet benchmark --data ROOT --methods examples/custom_method.py:make --out cards/
+seannet benchmark --data ROOT --methods examples/custom_method.py:ColourBoxes --out cards/
 """
 
 import torch

@@ -145,9 +145,10 @@ def _read(path: Path, stamp: tuple[int, int], max_pixels: int) -> Photo | str:
                     f"allowed (a guard against decompression bombs); to label it, start "
                     f"`sgdata label` with --max-pixels {width * height}"
                 )
-            orientation = image.getexif().get(_EXIF_ORIENTATION, 1)
             try:
                 image.load()  # decode every pixel now: a truncated file fails here, not later
+                # after load: a PNG's EXIF chunk may sit after its pixels, so reading it decodes
+                orientation = image.getexif().get(_EXIF_ORIENTATION, 1)
             except (OSError, ValueError, SyntaxError) as exc:
                 return f"cannot be decoded ({exc}); re-copy or re-export the photo"
     except (UnidentifiedImageError, OSError, ValueError):

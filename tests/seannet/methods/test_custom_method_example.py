@@ -24,6 +24,8 @@ def test_the_example_is_a_short_file_one_command_from_a_card(
     tmp_path: Path, mini_dataset: Path
 ) -> None:
     assert len(EXAMPLE.read_text().splitlines()) <= 30
+    # the command its docstring gives names the factory this test runs
+    assert "--methods examples/custom_method.py:ColourBoxes " in EXAMPLE.read_text()
     method = f"{EXAMPLE}:ColourBoxes"
     done = _run("benchmark", "--data", str(mini_dataset), "--methods", method, "--out", "cards",
                 cwd=tmp_path)  # fmt: skip

@@ -41,6 +41,14 @@ def test_a_truncated_jpeg_is_skipped_with_its_reason(tmp_path: Path) -> None:
     assert name == "cut.jpg" and why.startswith("cannot be decoded (image file is truncated")
 
 
+def test_a_truncated_png_is_skipped_as_undecodable_not_as_not_an_image(tmp_path: Path) -> None:
+    make_photo(tmp_path / "whole.png", 320, 240, seed=5)
+    data = (tmp_path / "whole.png").read_bytes()
+    (tmp_path / "cut.png").write_bytes(data[: len(data) * 2 // 3])
+    ((name, why),) = scan_photos(tmp_path).skipped
+    assert name == "cut.png" and why.startswith("cannot be decoded ("), why
+
+
 def test_an_oversized_png_says_how_to_allow_it(tmp_path: Path) -> None:
     _big_png(tmp_path / "huge.png", 20000)
     ((_, why),) = scan_photos(tmp_path).skipped
