@@ -7,7 +7,6 @@ from typing import Annotated
 
 import typer
 from rich.console import Console
-from rich.markup import escape
 from rich.table import Table
 from sgdata_cli.errors import run_app
 
@@ -19,6 +18,7 @@ from seannet.training.config import DEFAULT_PRESET, PRESETS
 from sgdata.errors import SgdataError
 
 app = typer.Typer(
+    rich_markup_mode=None,  # help text as written: a config's [catalog] stays
     name="seannet",
     help="Train and evaluate SeanNet and image baselines on sgdata datasets.",
     no_args_is_help=True,
@@ -157,7 +157,7 @@ def compare(
     models: Annotated[
         str,
         typer.Option(
-            help=f"Comma-separated model specs; {escape(spec_help())}. E.g. resnet18+boxes, "
+            help=f"Comma-separated model specs; {spec_help()}. E.g. resnet18+boxes, "
             "seannet@lite0+imagenet"
         ),
     ] = "seannet,resnet18",
@@ -528,6 +528,7 @@ def leaderboard(
 
 
 results_app = typer.Typer(
+    rich_markup_mode=None,  # help text as written: a config's [catalog] stays
     help="The protocol of docs/results.md as units of at most 45 min, each ending in a "
     "committed record: plan them, run them under a time limit, write the docs from records.",
     no_args_is_help=True,

@@ -15,6 +15,7 @@ from sgdata_cli.errors import run_app
 from sgdata.dataset.paths import MANIFEST
 
 app = typer.Typer(
+    rich_markup_mode=None,  # help text as written: a config's [catalog] stays
     name="sgdata",
     help="Generate, validate and serve scene-graph datasets of rooms whose objects move.",
     no_args_is_help=True,
@@ -581,6 +582,7 @@ def export(
 
 
 assets_app = typer.Typer(
+    rich_markup_mode=None,  # help text as written: a config's [catalog] stays
     help="Objects you bring: mesh files as catalog classes (docs/rooms.md).",
     no_args_is_help=True,
 )
