@@ -156,6 +156,8 @@ def sample(pixels: np.ndarray, uvs: np.ndarray) -> np.ndarray:
 def _read_trimesh(file: Path) -> RawMesh:
     import trimesh  # late: heavy, and only the reading side needs it
 
+    if file.stat().st_size == 0:  # trimesh would answer with an index error of its own
+        raise CatalogError(f"{file}: the file is empty (0 bytes); re-export it")
     try:
         loaded = trimesh.load(str(file), process=False)
     except Exception as exc:  # noqa: BLE001 -- any reader failure is the file's fault

@@ -159,6 +159,11 @@ def test_empty_mesh(tmp_path: Path) -> None:
     assert "holds no triangles" in _refusal(tmp_path, "e.obj", "# nothing\n")
 
 
+def test_an_empty_file_is_named_as_such_not_by_the_readers_index_error(tmp_path: Path) -> None:
+    message = _refusal(tmp_path, "e.glb", b"")
+    assert message.endswith("e.glb: the file is empty (0 bytes); re-export it"), message
+
+
 def test_nan_vertices(tmp_path: Path) -> None:
     text = _obj(["0 0 0", "nan 0 0", "0 1 0", "1 1 1"], ["1 2 3", "1 3 4"])
     message = _refusal(tmp_path, "n.obj", text)
