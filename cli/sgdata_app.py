@@ -444,7 +444,17 @@ def label(
             f"{done.triplets} triplet(s) to {done.root} (split {done.split})"
         )
         if done.unlabeled:
-            console.print(f"left out {len(done.unlabeled)} photo(s) without a room id")
+            console.print(
+                f"left out {len(done.unlabeled)} photo(s) without a room id: "
+                + ", ".join(done.unlabeled),
+                markup=False,
+            )
+        if done.never_labeled:
+            console.print(
+                f"left out {len(done.never_labeled)} photo(s) never labeled: "
+                + ", ".join(done.never_labeled),
+                markup=False,
+            )
         if done.pending:
             where = ", ".join(f"{name} ({n})" for name, n in done.pending.items())
             console.print(

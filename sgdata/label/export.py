@@ -44,6 +44,7 @@ class ExportSummary:
     observations: int = 0
     triplets: int = 0
     unlabeled: list[str] = field(default_factory=list)  # photos without a room id (left out)
+    never_labeled: list[str] = field(default_factory=list)  # photos with no labels saved
     pending: dict[str, int] = field(default_factory=dict)  # photo -> proposals never decided
     dropped: int = 0  # objects beyond their class's slot run
     notes: list[str] = field(default_factory=list)
@@ -105,6 +106,13 @@ def export_dataset(
         if pending:
             summary.pending[photo_name] = pending
         rooms.setdefault(labels.room_id, []).append(_Row(photo, labels, _row_id(photo, labels)))
+    summary.never_labeled = sorted(set(index.photos) - set(store.labeled()))
+    if not rooms:  # an empty dataset is no export: say which photos wait, write nothing
+        waiting = summary.unlabeled + summary.never_labeled
+        raise ConfigError(
+            f"{photos_dir}: nothing to export: no photo has labels with a room id "
+            f"({len(waiting)} waiting: {_names(waiting)}); label them in the page first"
+        )
     _check_rooms(rooms)
 
     from sgdata.dataset.manifest import FileEntry
@@ -134,6 +142,12 @@ def export_dataset(
     _write_manifest(root, name, version, split, rooms, files, triplets, sizes, rules, class_map)
     summary.triplets = len(triplets)
     return summary
+
+
+def _names(photos: list[str], shown: int = 5) -> str:
+    """The first ``shown`` photo names, and how many more."""
+    more = f" and {len(photos) - shown} more" if len(photos) > shown else ""
+    return (", ".join(photos[:shown]) or "none") + more
 
 
 def _clear_previous(root: Path) -> None:

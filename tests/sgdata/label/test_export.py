@@ -64,6 +64,20 @@ def test_export_writes_real_rows_that_validate(photos_dir: Path, tmp_path: Path)
     assert ds.splits == ("test",) or list(ds.splits) == ["test"]
 
 
+def test_export_with_nothing_labeled_names_the_waiting_photos_and_writes_nothing(
+    photos_dir: Path, tmp_path: Path
+) -> None:
+    out = tmp_path / "ds"
+    LabelStore(out).save("b.png", PhotoLabels())  # labels, but no room id
+    with pytest.raises(
+        ConfigError, match=r"nothing to export: .*\(3 waiting: b.png, a.png, c.jpg\)"
+    ):
+        export_dataset(photos_dir, out)
+    assert not (out / "dataset.json").exists()
+    done = run_cli("sgdata", "label", str(photos_dir), "--out", str(out), "--export")
+    assert done.returncode != 0 and "nothing to export" in done.stderr
+
+
 def test_export_makes_triplets_from_full_poses(tmp_path: Path) -> None:
     photos = tmp_path / "photos"
     photos.mkdir()
