@@ -23,6 +23,9 @@ from sgdata.world.mesh_assets import MESH_FORMATS, MeshAsset, class_assets
 __all__ = ["AddedClass", "add_asset_class"]
 
 SIZE_MARGIN = 0.1  # a new class's bounds: its files' sizes, this share either way
+# The largest side a new class may measure (m) by where it goes: a file past it is in other
+# units, or not the object it names (a sofa is 2.5 m, a counter 4 m, a mug 0.1 m)
+LARGEST_SIDE = {"floor": 5.0, "wall_floor": 5.0, "wall": 5.0, "surface": 2.0, "part": 2.0}
 _NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
 
 
@@ -97,6 +100,7 @@ def add_asset_class(
     text = _with_entry(before, class_name, fields)
     if new:  # measure once with open bounds, then bound the class by what was measured
         assets = _load(catalog, text, class_name)
+        _check_plausible(assets, str(placement), catalog, before)
         lo = [min(a.size[k] for a in assets) * (1 - SIZE_MARGIN) for k in range(3)]
         hi = [max(a.size[k] for a in assets) * (1 + SIZE_MARGIN) for k in range(3)]
         fields["size_min"] = [round(v, 3) for v in lo]
@@ -104,6 +108,30 @@ def add_asset_class(
         text = _with_entry(before, class_name, fields)
     assets = _load(catalog, text, class_name)
     return AddedClass(class_name, catalog, _table(class_name, fields), assets, new)
+
+
+def _check_plausible(
+    assets: tuple[MeshAsset, ...], placement: str, catalog: Path, before: str
+) -> None:
+    """Refuse a new class whose files measure past what its placement allows (the catalog
+    put back as it was), naming the size and the fix."""
+    limit = LARGEST_SIDE[placement]
+    for asset in assets:
+        if max(asset.size) > limit:
+            _restore(catalog, before)
+            size = " x ".join(f"{v:g}" for v in asset.size)
+            raise CatalogError(
+                f"{asset.path}: {size} m looks wrong for a {placement} object (at most {limit:g} m "
+                f"a side); if the file is in millimetres or centimetres give --units mm or cm, "
+                "or --scale fit to fit it into the class's bounds"
+            )
+
+
+def _restore(catalog: Path, before: str) -> None:
+    if before:
+        atomic_write_text(catalog, before)
+    else:
+        catalog.unlink(missing_ok=True)
 
 
 def _load(catalog: Path, text: str, class_name: str) -> tuple[MeshAsset, ...]:

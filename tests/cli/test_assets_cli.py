@@ -62,3 +62,25 @@ def test_a_bad_mesh_is_one_line_and_leaves_the_catalog(tmp_path: Path) -> None:
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and "empty.obj" in lines[0] and "no triangles" in lines[0]
     assert (tmp_path / "catalog.toml").read_text() == "# mine\n"
+
+
+def test_a_new_class_of_implausible_size_is_refused_with_the_fix(tmp_path: Path) -> None:
+    """An 800 m table as a new class is refused in one line naming the size and the units fix,
+    and the catalog is left as it was (an override of a shipped class is refused alike)."""
+    folder = tmp_path / "tables"
+    folder.mkdir()
+    corners = [(x, y, z) for x in (0, 800) for y in (0, 600) for z in (0, 500)]
+    faces = ["1 2 4 3", "5 7 8 6", "1 5 6 2", "3 4 8 7", "1 3 7 5", "2 6 8 4"]
+    (folder / "table.obj").write_text(
+        "".join(f"v {x} {y} {z}\n" for x, y, z in corners) + "".join(f"f {f}\n" for f in faces)
+    )
+    (tmp_path / "catalog.toml").write_text("# mine\n", encoding="utf-8")
+    done = run(
+        "assets", "add", "tables", "--class", "LowTable", "--dynamics", "static",
+        "--placement", "floor", "--units", "m", "--up", "z", cwd=tmp_path,
+    )  # fmt: skip
+    assert done.returncode == 2
+    (line,) = done.stderr.strip().splitlines()
+    assert "800 x 600 x 500 m looks wrong for a floor object (at most 5 m a side)" in line
+    assert "--units mm or cm" in line
+    assert (tmp_path / "catalog.toml").read_text() == "# mine\n"
