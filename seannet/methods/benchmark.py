@@ -45,7 +45,12 @@ from torch.utils.data import DataLoader
 from seannet.data.box_noise import BoxNoise
 from seannet.data.datasets import ImageTransform, ObservationDataset, collate_views, open_dataset
 from seannet.errors import MethodError
-from seannet.evaluation.intervals import per_room_matrix, t_interval, two_level_interval
+from seannet.evaluation.intervals import (
+    per_room_matrix,
+    t_interval,
+    two_level_interval,
+    wilson_interval,
+)
 from seannet.evaluation.retrieval import map_queries
 from seannet.methods.change import change_of_pairs, sweep
 from seannet.methods.checks import (
@@ -254,6 +259,7 @@ def _triplets(h: _Harness, e: _Embedded, split: str) -> tuple[np.ndarray, dict[s
         "triplets": int(len(correct)),
         "accuracy": float(correct.mean()) if len(correct) else float("nan"),
         "per_tier": {str(int(t)): float(correct[tiers == t].mean()) for t in sorted(set(tiers))},
+        "per_tier_triplets": {str(int(t)): int((tiers == t).sum()) for t in sorted(set(tiers))},
         "per_room": {str(r): float(correct[rooms == r].mean()) for r in sorted(set(rooms))},
         "room_triplets": {str(r): int((rooms == r).sum()) for r in sorted(set(rooms))},
     }
@@ -357,6 +363,17 @@ def _mean_bins(
     }
 
 
+def _floored(interval: dict[str, Any], triplets: int) -> dict[str, Any]:
+    """``interval`` never narrower than the binomial (Wilson) one of its mean over
+    ``triplets``: few rooms can make the room bootstrap's spread look smaller than the count
+    allows (two rooms of 10 triplets gave [68.5, 71.5])."""
+    w = wilson_interval(round(interval["mean"] * triplets), triplets)
+    if w["low"] >= interval["low"] and w["high"] <= interval["high"]:
+        return interval
+    return {**interval, "low": min(interval["low"], w["low"]),
+            "high": max(interval["high"], w["high"]), "floored_by": "binomial"}  # fmt: skip
+
+
 def summarize(runs: list[dict[str, Any]]) -> dict[str, Any]:
     """Over seeds: t-intervals, the two-level (rooms x seeds) interval of accuracy, the
     sweep's means and the breaking point."""
@@ -367,13 +384,17 @@ def summarize(runs: list[dict[str, Any]]) -> dict[str, Any]:
     summary: dict[str, Any] = {
         "seeds": len(runs),
         "accuracy": t_interval([r["accuracy"] for r in runs]),
-        "accuracy_rooms_seeds": two_level_interval(per_room_matrix(runs, rooms), weight),
+        "accuracy_rooms_seeds": _floored(
+            two_level_interval(per_room_matrix(runs, rooms), weight), runs[0]["triplets"]
+        ),
         "recall1": t_interval([r["retrieval"]["recall"]["1"] for r in runs]),
         "recall5": t_interval([r["retrieval"]["recall"]["5"] for r in runs]),
         "epsilon": float(np.mean([r["threshold"]["epsilon"] for r in runs])),
         "per_tier": {
             t: float(np.mean([r["per_tier"][t] for r in runs])) for t in runs[0]["per_tier"]
         },  # fmt: skip
+        "per_tier_triplets": runs[0].get("per_tier_triplets", {}),
+        "rooms": len(rooms),
         "change": change,
         "change_recall": change_recall,
         "breaks_at": {m: breaking_point(v) for m, v in change.items() if m != "moved_dynamics"},

@@ -118,9 +118,18 @@ def _markdown(card: dict[str, Any]) -> str:
         "- breaks at (first bin below halfway from its no-change accuracy to chance): "
         + ", ".join(f"{m.replace('_', ' ')} {_breaks(s, m)}" for m in s["breaks_at"]),
         "",
-        "Accuracy per tier (%):",
+        *_small_data_warning(s),
+        "Accuracy per tier (%, triplets):",
         "",
-        *table(list(s["per_tier"]), [[pct(v) for v in s["per_tier"].values()]]),
+        *table(
+            list(s["per_tier"]),
+            [
+                [
+                    f"{pct(v)} ({s.get('per_tier_triplets', {}).get(t, '?')})"
+                    for t, v in s["per_tier"].items()
+                ]
+            ],
+        ),  # fmt: skip
     ]
     for measure, bins in s["change"].items():
         lines += ["", f"The change sweep, {measure.replace('_', ' ')} (accuracy %, triplets):", ""]
@@ -144,6 +153,26 @@ def _markdown(card: dict[str, Any]) -> str:
     if "navigation" in s:
         lines += _navigation_lines(s["navigation"])
     return "\n".join(lines) + "\n"
+
+
+# Below these, a card's figures rest on too little to rank methods by (DESIGN §12)
+FEW_ROOMS, FEW_TRIPLETS = 5, 200
+
+
+def _small_data_warning(s: dict[str, Any]) -> list[str]:
+    """A warning line when the test split is small: the intervals are wide and a bin of a
+    sweep may hold a handful of triplets."""
+    rooms = s.get("rooms")
+    if (rooms is None or rooms >= FEW_ROOMS) and s["triplets"] >= FEW_TRIPLETS:
+        return [""]
+    held = f"{rooms} test rooms and " if rooms is not None else ""
+    return [
+        "",
+        f"**Warning: small test split** ({held}{s['triplets']} triplets; fewer than "
+        f"{FEW_ROOMS} rooms or {FEW_TRIPLETS} triplets): read the figures as a smoke test, "
+        "not a ranking; a bin's count is beside its accuracy.",
+        "",
+    ]
 
 
 def _navigation_lines(nav: dict[str, Any]) -> list[str]:

@@ -179,7 +179,21 @@ def test_reference_methods_get_cards_and_a_leaderboard(tmp_path: Path, mini_data
     tiny = json.loads((tmp_path / "tiny-image" / "card.json").read_text())["summary"]
     assert "box_noise" not in tiny  # no boxes, no box-noise sweep
     assert (tmp_path / "tiny-image" / "sweep.png").stat().st_size > 0
-    assert "Benchmark card: tiny-image" in (tmp_path / "tiny-image" / "card.md").read_text()
+    text = (tmp_path / "tiny-image" / "card.md").read_text()
+    assert "Benchmark card: tiny-image" in text
+    # the mini dataset's test split is small: the card says so, and shows each tier's count
+    assert f"({summary['rooms']} test rooms and {summary['triplets']} triplets" in text
+    assert "**Warning: small test split**" in text
+    assert sum(summary["per_tier_triplets"].values()) == summary["triplets"]
+    first_tier, count = next(iter(summary["per_tier_triplets"].items()))
+    tiers = text.split("Accuracy per tier")[1].split("The change sweep")[0]
+    assert f"({count})" in tiers
+    # never narrower than the binomial interval of its count
+    from seannet.evaluation.intervals import wilson_interval
+
+    interval = summary["accuracy_rooms_seeds"]
+    w = wilson_interval(round(interval["mean"] * summary["triplets"]), summary["triplets"])
+    assert interval["low"] <= w["low"] + 1e-12 and interval["high"] >= w["high"] - 1e-12
     table = leaderboard(read_cards([tmp_path]))
     assert "`tiny-image`" in table and "`boxes-overlap`" in table
 
