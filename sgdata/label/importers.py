@@ -171,6 +171,8 @@ def import_labels(
         photo.name: _labels(item, mapping, room, room_type)
         for item, photo in zip(foreign, matched, strict=True)
     }
+    if not labels:  # nothing to write: refused before the output folder exists
+        raise ConfigError(f"{annotations}: holds no photo's labels; nothing to import")
     store = LabelStore(out_dir)
     for name, value in labels.items():  # every photo checked: now write
         store.save(name, value.model_copy(update={"revision": store.load(name).revision}))

@@ -191,3 +191,13 @@ def test_cli_import_errors_are_one_line(photos_dir: Path, tmp_path: Path) -> Non
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and "'gizmo'" in lines[0] and "'coffee mug'" in lines[0]
     assert "Traceback" not in result.stderr
+
+
+def test_a_file_with_no_photos_labels_is_refused_and_writes_nothing(
+    photos_dir: Path, tmp_path: Path
+) -> None:
+    empty = tmp_path / "kitchen.json"
+    empty.write_text("[]", encoding="utf-8")  # a Label Studio export of no task
+    with pytest.raises(ConfigError, match="holds no photo's labels; nothing to import"):
+        import_labels("labelstudio", empty, photos_dir, tmp_path / "out")
+    assert not (tmp_path / "out").exists()
