@@ -10,9 +10,10 @@ import numpy as np
 import typer
 from rich.console import Console
 from rich.table import Table
-from sgdata_cli.errors import run_app
 
 from sgdata.dataset.paths import MANIFEST
+from sgdata.dataset.tolerance import Tolerance
+from sgdata_cli.errors import run_app
 
 app = typer.Typer(
     rich_markup_mode=None,  # help text as written: a config's [catalog] stays
@@ -346,12 +347,19 @@ def validate(
         Path | None,
         typer.Option(help="Folder of the generating config: check its [rooms] files unchanged."),
     ] = None,
+    against: Annotated[
+        Path | None,
+        typer.Option(
+            help="A reference dataset: fail when this one differs beyond sgdata diff's "
+            "tolerance (another CPU's edge pixels pass, and are reported)."
+        ),
+    ] = None,
     show: Annotated[int, typer.Option(help="Problems to list in the summary.")] = 20,
 ) -> None:
     """Check a dataset against its format; exit 0 only when every check passes."""
     from sgdata.validate import validate_dataset
 
-    report = validate_dataset(root, quick=quick, usd=usd, sources=sources)
+    report = validate_dataset(root, quick=quick, usd=usd, sources=sources, against=against)
     if json_out:
         print(report.to_json())
     else:
@@ -370,9 +378,38 @@ def validate(
             )
         if len(report.problems) > show:
             console.print(f"... and {len(report.problems) - show} more (--json lists all)")
+        for note in report.notes:
+            console.print(note, markup=False, soft_wrap=True)
         console.print("clean" if report.ok else f"{len(report.problems)} problem(s)")
     if not report.ok:
         raise typer.Exit(1)
+
+
+@app.command()
+def diff(
+    first: Annotated[Path, typer.Argument(help="A dataset directory (holding dataset.json).")],
+    second: Annotated[Path, typer.Argument(help="The dataset to compare it with.")],
+    pixel_share: Annotated[
+        float,
+        typer.Option(
+            min=0.0,
+            max=1.0,
+            help="Share of one view's pixels that may differ, per channel (also bounds an "
+            "object's visible-pixel count).",
+        ),
+    ] = Tolerance.pixel_share,
+    min_iou: Annotated[
+        float, typer.Option(min=0.0, max=1.0, help="Lowest IoU of a 2D box with its counterpart.")
+    ] = Tolerance.min_iou,
+) -> None:
+    """Tell how two datasets differ: manifest, rows, annotations, pixels per channel. Exit 0
+    when identical, 1 when they differ within the tolerance, 2 beyond it."""
+    from sgdata.dataset.diff import diff_datasets
+
+    report = diff_datasets(first, second, Tolerance(pixel_share=pixel_share, min_iou=min_iou))
+    for line in report.lines():
+        console.print(line, markup=False, soft_wrap=True)
+    raise typer.Exit(report.verdict)
 
 
 @app.command()
