@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 from rich.console import Console
 from rich.table import Table
+from sgdata_cli.errors import run_app
 
 from seannet.model.config import BACKBONES
 from seannet.model.specs import MODEL_NAMES, spec_help
@@ -15,7 +16,6 @@ from seannet.navigation.config import FUSIONS, MAP_SPACING, NavigationTestConfig
 from seannet.seeds import DEFAULT_SEEDS
 from seannet.training.config import DEFAULT_PRESET, PRESETS
 from sgdata.errors import SgdataError
-from sgdata_cli.errors import run_app
 
 app = typer.Typer(
     rich_markup_mode=None,  # help text as written: a config's [catalog] stays

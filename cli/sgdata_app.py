@@ -10,10 +10,10 @@ import numpy as np
 import typer
 from rich.console import Console
 from rich.table import Table
+from sgdata_cli.errors import run_app
 
 from sgdata.dataset.paths import MANIFEST
 from sgdata.dataset.tolerance import Tolerance
-from sgdata_cli.errors import run_app
 
 app = typer.Typer(
     rich_markup_mode=None,  # help text as written: a config's [catalog] stays
