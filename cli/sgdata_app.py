@@ -669,6 +669,7 @@ def assets_add(
     """Write a catalog class for a folder of mesh files and print what was measured."""
     from sgdata.usd.mesh_files import register_usd_mesh_reader
     from sgdata.world.asset_entries import add_asset_class
+    from sgdata.world.mesh_assets import orientation_warning
 
     register_usd_mesh_reader()  # USD / USDZ files too
 
@@ -694,13 +695,16 @@ def assets_add(
         table.add_row(
             Path(asset.path).name,
             Path(asset.path).suffix.lstrip("."),
-            asset.up.upper(),
+            f"{asset.up.upper()} ({asset.up_from})",
             asset.units,
             " x ".join(f"{v:.3f}" for v in asset.size),
             str(asset.triangles),
             surfaces or "-",
         )
     console.print(table)
+    warning = orientation_warning(added.name, added.assets)
+    if warning:
+        console.print(f"warning: {warning}", markup=False, highlight=False)
     console.print(added.entry.rstrip(), markup=False, highlight=False)
 
 
