@@ -63,10 +63,11 @@ __all__ = [
 MESH_FORMATS = {".glb": "y", ".gltf": "y", ".obj": "y", ".ply": "z", ".stl": "z"}
 # USD / USDZ: read by the reader sgdata.usd.mesh_files registers (an authored upAxis rules)
 MESH_FORMATS.update(dict.fromkeys((".usd", ".usda", ".usdc", ".usdz"), "y"))
-# Formats whose specification fixes the up axis: Y for glTF 2.0, Y for USD without an authored
-# upAxis (UsdGeom's fallback). Their axis is read, never guessed; OBJ, PLY and STL say
-# nothing, so theirs is measured (the axis that puts the size within the class's bounds).
-SPECIFIED_UP = (".glb", ".gltf", ".usd", ".usda", ".usdc", ".usdz")
+# Formats whose specification fixes the up axis: glTF 2.0 is Y up. Theirs is read, never
+# guessed. OBJ, PLY and STL say nothing, and USD without an authored upAxis is written Z up by
+# some tools despite UsdGeom's Y fallback: theirs is measured (the axis that puts the size
+# within the class's bounds).
+SPECIFIED_UP = (".glb", ".gltf")
 # How a file's up axis was decided, as the assets summary says it
 UP_FROM = ("given", "declared", "format", "measured")
 _UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001}
