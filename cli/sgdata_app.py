@@ -200,6 +200,17 @@ def generate(
     from sgdata.stage_clock import StageClock
 
     settings = load_config(config)
+    if settings.catalog.files and settings.rooms.procedural_types:
+        from sgdata.world.room_recipes import never_placed
+
+        for name in never_placed(settings.catalog.load()):
+            console.print(
+                f"warning: class {name} is in your catalog but no room recipe places it, so "
+                f"it can appear only in your own rooms ([rooms] files): give its entry rooms "
+                f"= {{kitchen = [1, 2]}} (or sgdata assets add --rooms kitchen:1-2)",
+                markup=False,
+                highlight=False,
+            )
     clock = StageClock() if profile else None
     workers = workers or os.cpu_count() or 1
     columns = (
@@ -304,6 +315,7 @@ def render(
             raise ConfigError(f"--pose {pose!r}: expected I,J,H such as 4,6,1") from None
         cell = (i, j)
     settings = load_config(config) if config is not None else GenerateConfig()
+    catalog = settings.catalog.load()  # a config's [catalog] files: its mesh and new classes
     record = render_snapshot(
         room_dir,
         layout=layout,
@@ -312,13 +324,13 @@ def render(
         camera=settings.camera,
         poses=settings.poses,
         annotation=settings.annotation,
-        catalog=settings.catalog.load(),  # a config's [catalog] files: its mesh classes
+        catalog=catalog,
         textures=textures,
     )
     overlay_path = output.with_suffix(".overlay.png")
     save_png(Image.fromarray(record.rgb), output)
     save_png(draw_overlay(record), overlay_path)
-    class_ids = {c.name: c.id for c in class_vocabulary()[1]}
+    class_ids = {c.name: c.id for c in class_vocabulary(catalog)[1]}
     channels_path = output.with_suffix(".channels.png")
     strip = channel_strip(
         record.rgb,
@@ -665,6 +677,13 @@ def assets_add(
     front: Annotated[
         str | None, typer.Option(help="The files' front axis: -y | +y | -x | +x")
     ] = None,
+    rooms: Annotated[
+        list[str] | None,
+        typer.Option(
+            help="Room type that holds it, TYPE or TYPE:LOW-HIGH per room (repeatable), e.g. "
+            "kitchen:1-2: how a new class gets into generated rooms."
+        ),
+    ] = None,
 ) -> None:
     """Write a catalog class for a folder of mesh files and print what was measured."""
     from sgdata.usd.mesh_files import register_usd_mesh_reader
@@ -685,6 +704,7 @@ def assets_add(
         units=units,
         scale=scale,
         front=front,
+        rooms=_room_counts(rooms or []),
     )
     verb = "new class" if added.new else "overrides the shipped class"
     table = Table(title=f"{added.name} ({verb}) in {added.catalog}")
@@ -705,7 +725,22 @@ def assets_add(
     warning = orientation_warning(added.name, added.assets)
     if warning:
         console.print(f"warning: {warning}", markup=False, highlight=False)
+    console.print(f"appears: {added.appears}", markup=False, highlight=False)
     console.print(added.entry.rstrip(), markup=False, highlight=False)
+
+
+def _room_counts(values: list[str]) -> dict[str, tuple[int, int]]:
+    """``--rooms`` values (``kitchen`` or ``kitchen:1-2``) as room type -> (low, high)."""
+    counts = {}
+    for value in values:
+        room_type, _, span = value.partition(":")
+        low, _, high = (span or "1").partition("-")
+        if not (low.isdigit() and (high or low).isdigit()):
+            raise typer.BadParameter(
+                f"--rooms {value!r}: expected TYPE or TYPE:LOW-HIGH, e.g. kitchen:1-2"
+            )
+        counts[room_type] = (int(low), int(high or low))
+    return counts
 
 
 main = run_app(app, "sgdata")
