@@ -13,6 +13,7 @@ from rich.table import Table
 from sgdata_cli.errors import run_app
 
 from sgdata.dataset.paths import MANIFEST
+from sgdata.dataset.tolerance import Tolerance
 
 app = typer.Typer(
     rich_markup_mode=None,  # help text as written: a config's [catalog] stays
@@ -199,6 +200,17 @@ def generate(
     from sgdata.stage_clock import StageClock
 
     settings = load_config(config)
+    if settings.catalog.files and settings.rooms.procedural_types:
+        from sgdata.world.room_recipes import never_placed
+
+        for name in never_placed(settings.catalog.load()):
+            console.print(
+                f"warning: class {name} is in your catalog but no room recipe places it, so "
+                f"it can appear only in your own rooms ([rooms] files): give its entry rooms "
+                f"= {{kitchen = [1, 2]}} (or sgdata assets add --rooms kitchen:1-2)",
+                markup=False,
+                highlight=False,
+            )
     clock = StageClock() if profile else None
     workers = workers or os.cpu_count() or 1
     columns = (
@@ -303,6 +315,7 @@ def render(
             raise ConfigError(f"--pose {pose!r}: expected I,J,H such as 4,6,1") from None
         cell = (i, j)
     settings = load_config(config) if config is not None else GenerateConfig()
+    catalog = settings.catalog.load()  # a config's [catalog] files: its mesh and new classes
     record = render_snapshot(
         room_dir,
         layout=layout,
@@ -311,13 +324,13 @@ def render(
         camera=settings.camera,
         poses=settings.poses,
         annotation=settings.annotation,
-        catalog=settings.catalog.load(),  # a config's [catalog] files: its mesh classes
+        catalog=catalog,
         textures=textures,
     )
     overlay_path = output.with_suffix(".overlay.png")
     save_png(Image.fromarray(record.rgb), output)
     save_png(draw_overlay(record), overlay_path)
-    class_ids = {c.name: c.id for c in class_vocabulary()[1]}
+    class_ids = {c.name: c.id for c in class_vocabulary(catalog)[1]}
     channels_path = output.with_suffix(".channels.png")
     strip = channel_strip(
         record.rgb,
@@ -346,12 +359,19 @@ def validate(
         Path | None,
         typer.Option(help="Folder of the generating config: check its [rooms] files unchanged."),
     ] = None,
+    against: Annotated[
+        Path | None,
+        typer.Option(
+            help="A reference dataset: fail when this one differs beyond sgdata diff's "
+            "tolerance (another CPU's edge pixels pass, and are reported)."
+        ),
+    ] = None,
     show: Annotated[int, typer.Option(help="Problems to list in the summary.")] = 20,
 ) -> None:
     """Check a dataset against its format; exit 0 only when every check passes."""
     from sgdata.validate import validate_dataset
 
-    report = validate_dataset(root, quick=quick, usd=usd, sources=sources)
+    report = validate_dataset(root, quick=quick, usd=usd, sources=sources, against=against)
     if json_out:
         print(report.to_json())
     else:
@@ -370,9 +390,38 @@ def validate(
             )
         if len(report.problems) > show:
             console.print(f"... and {len(report.problems) - show} more (--json lists all)")
+        for note in report.notes:
+            console.print(note, markup=False, soft_wrap=True)
         console.print("clean" if report.ok else f"{len(report.problems)} problem(s)")
     if not report.ok:
         raise typer.Exit(1)
+
+
+@app.command()
+def diff(
+    first: Annotated[Path, typer.Argument(help="A dataset directory (holding dataset.json).")],
+    second: Annotated[Path, typer.Argument(help="The dataset to compare it with.")],
+    pixel_share: Annotated[
+        float,
+        typer.Option(
+            min=0.0,
+            max=1.0,
+            help="Share of one view's pixels that may differ, per channel (also bounds an "
+            "object's visible-pixel count).",
+        ),
+    ] = Tolerance.pixel_share,
+    min_iou: Annotated[
+        float, typer.Option(min=0.0, max=1.0, help="Lowest IoU of a 2D box with its counterpart.")
+    ] = Tolerance.min_iou,
+) -> None:
+    """Tell how two datasets differ: manifest, rows, annotations, pixels per channel. Exit 0
+    when identical, 1 when they differ within the tolerance, 2 beyond it."""
+    from sgdata.dataset.diff import diff_datasets
+
+    report = diff_datasets(first, second, Tolerance(pixel_share=pixel_share, min_iou=min_iou))
+    for line in report.lines():
+        console.print(line, markup=False, soft_wrap=True)
+    raise typer.Exit(report.verdict)
 
 
 @app.command()
@@ -628,10 +677,18 @@ def assets_add(
     front: Annotated[
         str | None, typer.Option(help="The files' front axis: -y | +y | -x | +x")
     ] = None,
+    rooms: Annotated[
+        list[str] | None,
+        typer.Option(
+            help="Room type that holds it, TYPE or TYPE:LOW-HIGH per room (repeatable), e.g. "
+            "kitchen:1-2: how a new class gets into generated rooms."
+        ),
+    ] = None,
 ) -> None:
     """Write a catalog class for a folder of mesh files and print what was measured."""
     from sgdata.usd.mesh_files import register_usd_mesh_reader
     from sgdata.world.asset_entries import add_asset_class
+    from sgdata.world.mesh_assets import orientation_warning
 
     register_usd_mesh_reader()  # USD / USDZ files too
 
@@ -647,6 +704,7 @@ def assets_add(
         units=units,
         scale=scale,
         front=front,
+        rooms=_room_counts(rooms or []),
     )
     verb = "new class" if added.new else "overrides the shipped class"
     table = Table(title=f"{added.name} ({verb}) in {added.catalog}")
@@ -657,14 +715,32 @@ def assets_add(
         table.add_row(
             Path(asset.path).name,
             Path(asset.path).suffix.lstrip("."),
-            asset.up.upper(),
+            f"{asset.up.upper()} ({asset.up_from})",
             asset.units,
             " x ".join(f"{v:.3f}" for v in asset.size),
             str(asset.triangles),
             surfaces or "-",
         )
     console.print(table)
+    warning = orientation_warning(added.name, added.assets)
+    if warning:
+        console.print(f"warning: {warning}", markup=False, highlight=False)
+    console.print(f"appears: {added.appears}", markup=False, highlight=False)
     console.print(added.entry.rstrip(), markup=False, highlight=False)
+
+
+def _room_counts(values: list[str]) -> dict[str, tuple[int, int]]:
+    """``--rooms`` values (``kitchen`` or ``kitchen:1-2``) as room type -> (low, high)."""
+    counts = {}
+    for value in values:
+        room_type, _, span = value.partition(":")
+        low, _, high = (span or "1").partition("-")
+        if not (low.isdigit() and (high or low).isdigit()):
+            raise typer.BadParameter(
+                f"--rooms {value!r}: expected TYPE or TYPE:LOW-HIGH, e.g. kitchen:1-2"
+            )
+        counts[room_type] = (int(low), int(high or low))
+    return counts
 
 
 main = run_app(app, "sgdata")

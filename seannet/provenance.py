@@ -22,9 +22,6 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from sgdata.dataset.paths import MANIFEST
-from sgdata.fileio import sha256_file
-
 if TYPE_CHECKING:
     from sgdata.dataset import Dataset
 
@@ -95,9 +92,10 @@ PROCESS = ProcessState.capture()  # read once, when this process loaded seannet
 def provenance_record(
     data: Path | Dataset | None, *, step: str | None = None, process: ProcessState = PROCESS
 ) -> dict[str, Any]:
-    """One record: ``process``'s code and command, the time, and ``data``'s fingerprint
-    (its manifest's sha256, format and version, dataset seed) when given: a dataset opened
-    already (nothing is read again) or its root (its ``dataset.json`` read here)."""
+    """One record: ``process``'s code and command, the time, and ``data``'s two identities
+    when given: its recipe fingerprint (what was asked for, the same on every machine) and its
+    manifest's sha256 (what this machine produced), with format and version and dataset seed;
+    ``data`` is a dataset opened already (nothing is read again) or its root (opened here)."""
     record: dict[str, Any] = {
         "step": step,
         "commit": process.commit,
@@ -111,17 +109,15 @@ def provenance_record(
         return record
     from sgdata.dataset import Dataset  # here: importing seannet reads no Arrow
 
-    if isinstance(data, Dataset):  # opened already: its manifest and sha256, not read again
-        manifest, digest = data.manifest.to_dict(), data.manifest_sha256
-    else:
-        manifest = json.loads((Path(data) / MANIFEST).read_text())
-        digest = sha256_file(Path(data) / MANIFEST)[0]
+    dataset = data if isinstance(data, Dataset) else Dataset.open(Path(data))
+    manifest = dataset.manifest
     record |= {
-        "data": str(data.root if isinstance(data, Dataset) else data),
-        "manifest_sha256": digest,
-        "format": manifest.get("format"),
-        "format_version": manifest.get("format_version"),
-        "dataset_seed": manifest.get("config", {}).get("dataset", {}).get("seed"),
+        "data": str(dataset.root),
+        "recipe": manifest.recipe_fingerprint(),
+        "manifest_sha256": dataset.manifest_sha256,
+        "format": manifest.format,
+        "format_version": manifest.format_version,
+        "dataset_seed": manifest.config.get("dataset", {}).get("seed"),
     }
     return record
 
@@ -180,9 +176,10 @@ def stamp(records: Sequence[dict[str, Any]]) -> str:
         if r.get("manifest_sha256"):
             seed = r.get("dataset_seed")
             seed = f"dataset seed {seed}, " if seed is not None else ""
+            recipe = f"recipe `{r['recipe'][:16]}…`, " if r.get("recipe") else ""
             data = (
-                f" on `{r['data']}` ({seed}format {r.get('format_version')}, manifest sha256 "
-                f"`{r['manifest_sha256'][:16]}…`)"
+                f" on `{r['data']}` ({seed}format {r.get('format_version')}, {recipe}manifest "
+                f"sha256 `{r['manifest_sha256'][:16]}…`)"
             )
         parts.append(
             f"commit `{r['commit'][:10]}`{dirty}, started {r['started']}{data}: `{r['command']}`"

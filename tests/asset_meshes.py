@@ -32,7 +32,7 @@ mesh = "meshes/bowl*.ply"
 mesh = "meshes/plate*.stl"
 """
 
-_Y_UP = np.array([[1, 0, 0, 0], [0, 0, 1, 0], [0, -1, 0, 0], [0, 0, 0, 1]], float)  # z -> y
+Y_UP = np.array([[1, 0, 0, 0], [0, 0, 1, 0], [0, -1, 0, 0], [0, 0, 0, 1]], float)  # z -> y
 
 
 def _at(mesh: trimesh.Trimesh, x: float, y: float, z: float) -> trimesh.Trimesh:
@@ -105,7 +105,7 @@ def write_demo_assets(folder: Path, *, catalog: bool = True) -> list[Path]:
         ("top", "legs"), table(), ([150, 100, 60, 255], [40, 40, 44, 255]), strict=True
     ):
         part = part.copy()
-        part.apply_transform(_Y_UP)
+        part.apply_transform(Y_UP)
         material = trimesh.visual.material.PBRMaterial(baseColorFactor=rgba)
         part.visual = trimesh.visual.TextureVisuals(material=material)
         scene.add_geometry(part, geom_name=name)
@@ -118,7 +118,7 @@ def write_demo_assets(folder: Path, *, catalog: bool = True) -> list[Path]:
     uv = np.stack([angle, part.vertices[:, 2] / 0.1], axis=1)
     image = _checker(((200, 40, 40), (240, 230, 220)))
     part.visual = trimesh.visual.TextureVisuals(uv=uv, image=image)
-    part.apply_transform(_Y_UP)
+    part.apply_transform(Y_UP)
     part.apply_scale(100.0)
     files = trimesh.exchange.obj.export_obj(
         part, include_texture=True, return_texture=True, mtl_name="mug.mtl"

@@ -208,26 +208,36 @@ def _navigation_cell(card: dict[str, Any]) -> str:
 
 
 def _plot(card: dict[str, Any]) -> Image.Image:
-    """The change sweep as three small bar panels (accuracy per bin, 0.5 = chance)."""
+    """The change sweep as small bar panels: accuracy per bin on a 0-100 % axis (the chance
+    line at 50 %), each bin's triplet count under its name, and an empty bin drawn as a gap
+    that says so (never as a bar of 0 %)."""
     change = card["summary"]["change"]
     font = ImageFont.load_default(size=11)
-    width, height, pad = 240, 180, 30
-    image = Image.new("RGB", (pad + len(change) * (width + pad), height + 3 * pad), "white")
+    width, height, pad, axis = 240, 180, 30, 34
+    panel = axis + width + pad
+    image = Image.new("RGB", (pad + len(change) * panel, height + 4 * pad), "white")
     draw = ImageDraw.Draw(image)
     draw.text((pad, 6), f"{card['method']}: accuracy by change", fill="black", font=font)
     for k, (measure, bins) in enumerate(change.items()):
-        x0, y0 = pad + k * (width + pad), 2 * pad
+        x0, y0 = pad + axis + k * panel, 2 * pad
         draw.rectangle([x0, y0, x0 + width, y0 + height], outline="black")
+        for tick in (0, 25, 50, 75, 100):
+            y = y0 + height * (1 - tick / 100)
+            draw.line([x0 - 4, y, x0, y], fill="black")
+            draw.text((x0 - axis, y - 6), f"{tick} %", fill="black", font=font)
         chance = y0 + height * 0.5
         draw.line([x0, chance, x0 + width, chance], fill=(200, 200, 200))
         step = width / max(len(bins), 1)
         for j, (name, value) in enumerate(bins.items()):
-            acc = value["accuracy"]
+            acc, count = value["accuracy"], value["triplets"]
             left = x0 + j * step + 4
-            if not math.isnan(acc):
+            if count and not math.isnan(acc):
                 top = y0 + height * (1 - acc)
                 draw.rectangle([left, top, left + step - 8, y0 + height], fill=(70, 110, 200))
+            else:
+                draw.text((left, y0 + height - 16), "empty", fill=(150, 150, 150), font=font)
             draw.text((left, y0 + height + 4), name, fill="black", font=font)
+            draw.text((left, y0 + height + 18), f"n={count}", fill=(90, 90, 90), font=font)
         draw.text((x0, y0 - 16), measure.replace("_", " "), fill="black", font=font)
     return image
 

@@ -49,6 +49,7 @@ from sgdata.fileio import atomic_write_bytes, atomic_write_text, save_png
 __all__ = ["Records", "leaderboard_doc", "results_doc", "write_docs"]
 
 CONTACT_SHEET = "images/covisibility-disagreements.png"  # under the docs folder
+AIM = 0.9  # the learning aim: triplet accuracy on test, and full-map recall@1
 
 
 # ------------------------------------------------------------------------------ results.md
@@ -212,7 +213,7 @@ def _aims(r: Records, baseline: str | None, losses: dict[str, float | None],
     rows = []
     mean = summarize(ours)["accuracy"]["mean"] if ours else None
     rows.append([f"{first} >= 90 %", pct(mean),
-                 "" if mean is None else verdict(mean >= 0.9, first)])  # fmt: skip
+                 "" if mean is None else verdict(mean >= AIM, first)])  # fmt: skip
     if baseline and ours and r.runs(baseline):
         d = difference(ours, r.runs(baseline))["rooms_seeds"]
         met = verdict(d["mean"] >= 0.03 and d["low"] > 0, first, baseline)
@@ -225,7 +226,7 @@ def _aims(r: Records, baseline: str | None, losses: dict[str, float | None],
                  "" if loss is None else verdict(loss <= 0.03, first)])  # fmt: skip
     got = recall.get(first)
     rows.append(["full-map recall@1 >= 90 %", pct(got),
-                 "" if got is None else ("yes" if got >= 0.9 else "no")])  # fmt: skip
+                 "" if got is None else ("yes" if got >= AIM else "no")])  # fmt: skip
     return table(["aim", "measured", "met"], rows)
 
 
@@ -301,11 +302,44 @@ def _covisibility(r: Records, baseline: str | None) -> list[str]:
         "",
         *table(["model", "all %", "decidable %", "not decidable %"], decidable),
         "",
+        *_aim_against_the_oracle(methods, outcomes, right, overall),
+        "",
         f"![triplets where covisibility disagrees with the label]({CONTACT_SHEET})",
         "",
         f"{len(o['disagreements'])} of the {o['triplets'] - int(right.sum())} triplets where "
         "covisibility disagrees with the label (anchor, positive, negative), spread evenly "
         "over them.",
+    ]
+
+
+def _aim_against_the_oracle(
+    methods: Sequence[str], outcomes: dict[str, np.ndarray], right: np.ndarray, oracle: float
+) -> list[str]:
+    """What the oracle says of the 90 % aim, from the best of ``methods`` on all triplets."""
+    best = max(methods, key=lambda m: float(outcomes[m].mean()))
+    every, decided = float(outcomes[best].mean()), float(outcomes[best][right].mean())
+    rest = float(outcomes[best][~right].mean()) if (~right).any() else float("nan")
+    if every > oracle:
+        cap = (
+            f"- The oracle is no ceiling: `{best}` gets {pct(every)} % of all test triplets "
+            f"against the oracle's {pct(oracle)} %, and {pct(rest)} % of the "
+            f"{int((~right).sum())} that covisibility orders wrongly (chance: 50 %): what is "
+            "seen where (objects, their boxes) decides triplets the shared view does not."
+        )
+    else:
+        cap = (
+            f"- No method beats the oracle yet: the best, `{best}`, gets {pct(every)} % of all "
+            f"test triplets against the oracle's {pct(oracle)} %."
+        )
+    short = "meets it" if decided >= AIM else f"is {100 * (AIM - decided):.1f} points short"
+    return [
+        "What this says of the 90 % aim:",
+        "",
+        cap,
+        f"- On the triplets the views decide, `{best}` gets {pct(decided)} %: it {short}.",
+        "- The aim stays 90 % on all test triplets, the paper's figure: nothing measured here "
+        "shows the views cap it below. Both figures are reported: all triplets (the aim) and "
+        "the decidable ones (the table above).",
     ]
 
 

@@ -15,6 +15,11 @@ No worker outlives its parent: local workers ask the kernel for SIGKILL when the
 ``sgdata generate`` takes them with it (the multiprocessing resource tracker then sees its pipe
 close and exits too). A local Ray instance started by the run shares the driver's fate the
 same way (Ray starts its processes with ``fate_share``).
+
+A local worker that dies of a signal (a segfault in the driver, an abort, the kernel's
+out-of-memory killer) breaks the pool; the run then ends in one :class:`WorkerError` naming the
+worker, the signal and the task it was on (each worker notes its task in a file of a temporary
+folder while it runs it), and ``--resume`` finishes it.
 """
 
 from __future__ import annotations
@@ -23,14 +28,25 @@ import ctypes
 import multiprocessing
 import os
 import signal
+import tempfile
 from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
+from multiprocessing.process import BaseProcess
+from pathlib import Path
 from typing import Any
 
-from sgdata.errors import ConfigError
+from sgdata.errors import ConfigError, WorkerError
 
-__all__ = ["EXECUTORS", "WORKER_ENV", "run_tasks", "executor_session", "die_with_parent"]
+__all__ = [
+    "EXECUTORS",
+    "WORKER_ENV",
+    "run_tasks",
+    "executor_session",
+    "die_with_parent",
+    "task_name",
+]
 
 EXECUTORS = ("local", "ray")
 WORKER_ENV = {"LP_NUM_THREADS": "1"}  # set in every worker before pyrender or Mesa load
@@ -105,22 +121,68 @@ def _check(executor: str, address: str | None) -> None:
 
 def _run_local(fn: Callable[..., dict], jobs: list[tuple], *, workers: int) -> Iterator[dict]:
     context = multiprocessing.get_context("spawn")
-    with ProcessPoolExecutor(
-        max_workers=min(workers, len(jobs)),
-        mp_context=context,
-        initializer=_init_worker,
-        initargs=(os.getpid(),),
-    ) as pool:
-        pending: set[Future[Any]] = {pool.submit(fn, *payload) for payload in jobs}
+    with (
+        tempfile.TemporaryDirectory(prefix="sgdata-tasks-") as notes,
+        ProcessPoolExecutor(
+            max_workers=min(workers, len(jobs)),
+            mp_context=context,
+            initializer=_init_worker,
+            initargs=(os.getpid(),),
+        ) as pool,
+    ):
+        pending: set[Future[Any]] = {
+            pool.submit(_noted, Path(notes), task_name(payload, k), fn, *payload)
+            for k, payload in enumerate(jobs)
+        }
+        # every worker has started once all is submitted; kept to read a dead one's exit code
+        started: dict[int, BaseProcess] = dict(getattr(pool, "_processes", None) or {})
         try:
             while pending:
                 finished, pending = wait(pending, return_when=FIRST_COMPLETED)
                 for future in finished:
-                    yield future.result()
+                    try:
+                        result = future.result()
+                    except BrokenProcessPool:
+                        raise WorkerError(_death(started, Path(notes))) from None
+                    yield result
         except BaseException:
             for future in pending:
                 future.cancel()
             raise
+
+
+def task_name(payload: tuple, index: int) -> str:
+    """How a message names a task: its room when it has one."""
+    room = getattr(payload[0], "room_id", None) if payload else None
+    return f"room {room}" if room else f"task {index + 1}"
+
+
+def _noted(notes: Path, name: str, fn: Callable[..., dict], *payload: Any) -> dict:
+    """Run ``fn`` in a worker with a note of what it is on, for the message should it die."""
+    note = notes / str(os.getpid())
+    note.write_text(name)
+    result = fn(*payload)
+    note.unlink()
+    return result
+
+
+def _death(started: dict[int, BaseProcess], notes: Path) -> str:
+    """One line on the worker that broke the pool: its pid, the signal, the task it was on.
+    The pool stops the other workers with SIGTERM; the dead one is the one without it."""
+    for pid, process in sorted(started.items()):
+        process.join(timeout=5)
+        code = process.exitcode
+        if code is None or code >= 0 or -code == signal.SIGTERM:
+            continue
+        name = signal.Signals(-code).name
+        note = notes / str(pid)
+        task = note.read_text() if note.exists() else "no task (between tasks)"
+        hint = " (SIGKILL is what the out-of-memory killer sends: try fewer --workers)"
+        return (
+            f"worker {pid} died of {name} while on {task}"
+            f"{hint if -code == signal.SIGKILL else ''}; rerun with --resume"
+        )
+    return "a worker died and its signal is unknown; rerun with --resume"
 
 
 def die_with_parent(parent: int) -> None:

@@ -18,6 +18,7 @@ import ray
 from ray.exceptions import RayActorError, RayTaskError, WorkerCrashedError
 
 from sgdata.errors import SgdataError, WorkerError
+from sgdata.pipeline.executors import task_name
 from sgdata.pipeline.reaper import start_reaper
 
 __all__ = ["run_on_ray", "ray_session"]
@@ -93,10 +94,9 @@ def _run(
 def _retry(index: int, jobs: list[tuple], tries: Counter[int], retries: int, why: str) -> None:
     tries[index] += 1
     if tries[index] > retries:
-        task = jobs[index][0]
-        name = getattr(task, "room_id", f"task {index}")
         raise WorkerError(
-            f"room {name} failed {tries[index]} times on Ray ({why}); rerun with --resume"
+            f"{task_name(jobs[index], index)} failed {tries[index]} times on Ray ({why}); "
+            "rerun with --resume"
         )
 
 

@@ -77,8 +77,16 @@ def use_egl_platform() -> None:
 
     Must run before pyrender/OpenGL is first imported; a value the caller already set (for
     example ``osmesa``) is left alone.
+
+    llvmpipe forced to 128-bit vectors (``LP_NATIVE_VECTOR_WIDTH=128``) on a CPU with AVX
+    aborts drawing a primitive with vertex colours, normals and a texture, as every textured
+    one of ours is (Mesa 22.3, ``scripts/llvmpipe_width128_repro.py``). A CPU without AVX draws
+    at that width with SSE4.1 code and does not abort, so a forced 128 gets that CPU's
+    features too (x86 only; a value the caller set is kept).
     """
     os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
+    if os.environ.get("LP_NATIVE_VECTOR_WIDTH") == "128":
+        os.environ.setdefault("GALLIUM_OVERRIDE_CPU_CAPS", "sse4.1")
 
 
 @dataclass

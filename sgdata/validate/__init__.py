@@ -3,9 +3,9 @@
 One entry point, :func:`validate_dataset`, runs the check families in order (see
 docs/validate.md): manifest, files, metadata (card and Croissant), tables,
 rows/objects/relations, relation recompute, triplets, images, channels (depth and masks),
-scenes, and with ``sources`` the
-user room files. Nothing stops at the
-first failure: the report lists every :class:`Problem` with its file, row and field.
+scenes, with ``sources`` the user room files, and with ``against`` a reference dataset
+(:mod:`sgdata.dataset.diff`). Nothing stops at the first failure: the report lists every
+:class:`Problem` with its file, row and field.
 """
 
 from __future__ import annotations
@@ -31,6 +31,7 @@ from sgdata.validate.manifest_checks import (
 )
 from sgdata.validate.metadata_checks import check_metadata
 from sgdata.validate.problems import Collector, Problem, ValidationReport
+from sgdata.validate.reference_checks import check_against
 from sgdata.validate.relation_checks import check_recompute
 from sgdata.validate.scene_checks import check_scenes
 from sgdata.validate.source_checks import CHECK as SOURCES_CHECK
@@ -41,7 +42,12 @@ __all__ = ["Problem", "ValidationReport", "compare_schema", "validate_dataset"]
 
 
 def validate_dataset(
-    root: str | Path, *, quick: bool = False, usd: bool = False, sources: Path | None = None
+    root: str | Path,
+    *,
+    quick: bool = False,
+    usd: bool = False,
+    sources: Path | None = None,
+    against: Path | None = None,
 ) -> ValidationReport:
     """Check the dataset at ``root``; every failure becomes a :class:`Problem`.
 
@@ -52,6 +58,8 @@ def validate_dataset(
         sources: the folder of the config that generated the dataset: its ``[rooms] files``
             and the files of its ``[catalog]`` (catalogs, meshes, textures) must still have the
             sha256 the manifest records.
+        against: a reference dataset: differences beyond :class:`~sgdata.dataset.diff.Tolerance`
+            fail the ``against.reference`` check; those within it are the report's ``notes``.
 
     Returns:
         the report; ``report.ok`` is True only when no check failed.
@@ -69,6 +77,8 @@ def validate_dataset(
             check_sources(raw, Path(sources), out)
         elif user_room_files(raw) or catalog_asset_files(raw):
             out.skipped.append(SOURCES_CHECK)
+        if against is not None:
+            check_against(root, Path(against), out)
     if quick:
         out.skipped.append("images.decode")
         out.skipped.append("images.size")
@@ -81,6 +91,7 @@ def validate_dataset(
         checked=dict(out.checked),
         skipped=out.skipped,
         elapsed=time.perf_counter() - start,
+        notes=out.notes,
     )
 
 

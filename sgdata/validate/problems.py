@@ -38,6 +38,7 @@ class ValidationReport:
     checked: dict[str, int]  # check name -> items examined (rows, files, pairs ...)
     skipped: list[str]  # check names not run (e.g. images under --quick)
     elapsed: float  # seconds
+    notes: list[str] = field(default_factory=list)  # what is worth saying but fails nothing
 
     @property
     def ok(self) -> bool:
@@ -62,6 +63,7 @@ class ValidationReport:
             ],
             "skipped": list(self.skipped),
             "problems": [asdict(p) for p in self.problems],
+            "notes": list(self.notes),
         }
 
     def to_json(self) -> str:
@@ -76,6 +78,7 @@ class Collector:
     problems: list[Problem] = field(default_factory=list)
     checked: Counter = field(default_factory=Counter)
     skipped: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
 
     def count(self, check: str, n: int = 1) -> None:
         """Record that ``check`` examined ``n`` more items."""

@@ -17,8 +17,9 @@ from pathlib import Path
 
 from sgdata.errors import CatalogError
 from sgdata.fileio import atomic_write_text
-from sgdata.world.catalog import PLACEMENTS, load_catalog
+from sgdata.world.catalog import PLACEMENTS, ClassSpec, load_catalog
 from sgdata.world.mesh_assets import MESH_FORMATS, MeshAsset, class_assets
+from sgdata.world.room_recipes import load_room_recipes
 
 __all__ = ["AddedClass", "add_asset_class"]
 
@@ -38,6 +39,7 @@ class AddedClass:
     entry: str  # the TOML table written
     assets: tuple[MeshAsset, ...]  # the files, measured (variant order)
     new: bool  # a class the shipped catalog lacks
+    appears: str  # where generated rooms will hold it, for people
 
 
 def add_asset_class(
@@ -53,9 +55,11 @@ def add_asset_class(
     units: str | None = None,
     scale: str | None = None,
     front: str | None = None,
+    rooms: dict[str, tuple[int, int]] | None = None,
 ) -> AddedClass:
     """Write (or replace) ``class_name``'s entry in ``catalog`` for the mesh files in
-    ``folder``, and measure them.
+    ``folder``, and measure them. ``rooms`` (room type -> how many per room) puts the class
+    into those room types' recipes: how a new class gets into generated rooms.
 
     Raises:
         CatalogError: no mesh file in ``folder``, a new class without dynamics or placement, a
@@ -89,6 +93,10 @@ def add_asset_class(
         fields["receptacles"] = list(receptacles)
     if containers:
         fields["containers"] = list(containers)
+    if rooms:
+        fields["rooms"] = {t: list(count) for t, count in rooms.items()}
+        if new:  # a room may hold as many as its entry asks (each instance takes a GCN slot)
+            fields["max_instances"] = max(1, *(high for _, high in rooms.values()))
     if new:
         if dynamics is None or placement is None:
             raise CatalogError(
@@ -107,7 +115,24 @@ def add_asset_class(
         fields["size_max"] = [round(v, 3) for v in hi]
         text = _with_entry(before, class_name, fields)
     assets = _load(catalog, text, class_name)
-    return AddedClass(class_name, catalog, _table(class_name, fields), assets, new)
+    appears = _where_it_appears(load_catalog(extra=[catalog])[class_name], new)
+    return AddedClass(class_name, catalog, _table(class_name, fields), assets, new, appears)
+
+
+def _where_it_appears(spec: ClassSpec, new: bool) -> str:
+    """Where generated rooms will hold the class: the room types its entry names (and on
+    what), the shipped class's places for an override, or nowhere."""
+    on = [*spec.receptacles, *(f"in {c}" for c in spec.containers)]
+    resting = f", on {', '.join(on)}" if spec.placement == "surface" and on else ""
+    added = [f"{t} rooms ({lo}-{hi} per room{resting})" for t, lo, hi in spec.rooms]
+    if not new:
+        added.insert(0, f"wherever the shipped {spec.name} stands")
+    if not added:
+        return (
+            "in no generated room: no room recipe places a new class; give --rooms "
+            "kitchen:1-2 (any of its room types), or put it in your own rooms ([rooms] files)"
+        )
+    return "; ".join(added)
 
 
 def _check_plausible(
@@ -140,6 +165,7 @@ def _load(catalog: Path, text: str, class_name: str) -> tuple[MeshAsset, ...]:
     atomic_write_text(catalog, text)
     try:
         merged = load_catalog(extra=[catalog])
+        load_room_recipes(merged)  # its rooms name known room types
         return class_assets(merged[class_name])
     except CatalogError:
         if before is None:
@@ -150,6 +176,8 @@ def _load(catalog: Path, text: str, class_name: str) -> tuple[MeshAsset, ...]:
 
 
 def _toml(value: object) -> str:
+    if isinstance(value, dict):
+        return "{ " + ", ".join(f"{k} = {_toml(v)}" for k, v in value.items()) + " }"
     if isinstance(value, str):
         return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
     if isinstance(value, list):

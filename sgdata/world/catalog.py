@@ -55,6 +55,7 @@ _FIELDS = {
     "description",
     "anchors",
     "anchor_sides",
+    "rooms",
     # a class made of mesh files (sgdata.world.mesh_assets) instead of a recipe
     "mesh",
     "scale",
@@ -109,6 +110,9 @@ class ClassSpec:
     anchors: tuple[str, ...] = ()  # floor classes: what it stands at, in order of preference
     anchor_sides: tuple[str, ...] = ()  # sides others stand at; () = by placement (see below)
     mesh: MeshSource | None = None  # a class of mesh files (then ``shape`` is MESH_SHAPE)
+    # the room types whose recipes place it, with how many per room: (type, low, high), added
+    # to the shipped recipes by sgdata.world.room_recipes (how a new class gets into rooms)
+    rooms: tuple[tuple[str, int, int], ...] = ()
 
     def sides_to_stand_at(self) -> tuple[str, ...]:
         """Sides of this class that an object anchored to it may stand at: ``anchor_sides``
@@ -299,7 +303,36 @@ def _parse_class(path: Path, name: str, entry: Any) -> ClassSpec:
         anchors=anchors,
         anchor_sides=anchor_sides,
         mesh=mesh,
+        rooms=_rooms(where, entry.get("rooms", {}), placement, max_instances),
     )
+
+
+def _rooms(
+    where: str, value: Any, placement: str, max_instances: int
+) -> tuple[tuple[str, int, int], ...]:
+    """The ``rooms`` field, ``{kitchen = [1, 2], ...}``: per room type, how many per room
+    (the type names are checked against the recipes, sgdata.world.room_recipes)."""
+    if not value:
+        return ()
+    if placement == "part":
+        raise CatalogError(f"{where}: field 'rooms': a 'part' is placed by its owner's recipe")
+    shape = "like {kitchen = [1, 2]} (room type = [low, high] per room)"
+    if not isinstance(value, dict):
+        raise CatalogError(f"{where}: field 'rooms' must be a table {shape}")
+    out = []
+    for room_type, count in sorted(value.items()):
+        if not (
+            isinstance(count, list)
+            and len(count) == 2
+            and all(isinstance(c, int) and not isinstance(c, bool) for c in count)
+            and 0 <= count[0] <= count[1] <= max_instances
+        ):
+            raise CatalogError(
+                f"{where}: field 'rooms': {room_type} = {count!r}; expected [low, high] with "
+                f"0 <= low <= high <= max_instances ({max_instances})"
+            )
+        out.append((str(room_type), count[0], count[1]))
+    return tuple(out)
 
 
 _MESH_ONLY = {"scale", "up", "units", "front", "max_triangles"}

@@ -22,6 +22,7 @@ goes to the manifest: :func:`asset_files`).
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import math
 from dataclasses import dataclass
@@ -54,6 +55,7 @@ __all__ = [
     "class_sizes",
     "mesh_build",
     "mesh_footprint",
+    "orientation_warning",
     "read_asset",
 ]
 
@@ -61,6 +63,13 @@ __all__ = [
 MESH_FORMATS = {".glb": "y", ".gltf": "y", ".obj": "y", ".ply": "z", ".stl": "z"}
 # USD / USDZ: read by the reader sgdata.usd.mesh_files registers (an authored upAxis rules)
 MESH_FORMATS.update(dict.fromkeys((".usd", ".usda", ".usdc", ".usdz"), "y"))
+# Formats whose specification fixes the up axis: glTF 2.0 is Y up. Theirs is read, never
+# guessed. OBJ, PLY and STL say nothing, and USD without an authored upAxis is written Z up by
+# some tools despite UsdGeom's Y fallback: theirs is measured (the axis that puts the size
+# within the class's bounds).
+SPECIFIED_UP = (".glb", ".gltf")
+# How a file's up axis was decided, as the assets summary says it
+UP_FROM = ("given", "declared", "format", "measured")
 _UNITS = {"m": 1.0, "cm": 0.01, "mm": 0.001}
 # a measured size this far (as a factor) outside the class's bounds is refused under `keep`
 SIZE_TOLERANCE = 1.25
@@ -85,6 +94,7 @@ class MeshAsset:
     face_colors: np.ndarray  # (F, 3) float32, linear RGB in [0, 1]
     size: tuple[float, float, float]  # width, depth, height (m) as measured
     up: str  # the file's up axis: "y" or "z"
+    up_from: str  # how it was decided, one of UP_FROM
     units: str  # the file's unit: "m", "cm" or "mm"
     footprint: np.ndarray  # (K, 2) convex hull of the floor projection, counter-clockwise
     surfaces: tuple[Surface, ...]  # support surfaces from upward faces
@@ -169,9 +179,14 @@ def _read_cached(
     textures = sorted({*textures, *(Path(p) for p in raw.texture_paths)})
     vertices, keep = _checked(file, raw.vertices, raw.faces)
     faces = raw.faces[keep].astype(np.int32)
+    up_from = "given" if source.up != "auto" else "declared" if raw.up is not None else None
+    if up_from is None:
+        up_from = "format" if suffix in SPECIFIED_UP else "measured"
     source = _declared(raw, source)
     if raw.meters_per_unit is not None:  # the file says its unit: read it in metres
         vertices = vertices * raw.meters_per_unit
+    if up_from == "format":
+        source = dataclasses.replace(source, up=MESH_FORMATS[suffix])
     up, units, scale = _measure(file, vertices, source, size_min, size_max, class_name)
     local = _to_local(vertices, up, source.front) * _UNITS[units] * scale
     lo, hi = local.min(axis=0), local.max(axis=0)
@@ -185,6 +200,7 @@ def _read_cached(
         face_colors=np.clip(raw.colors[keep], 0.0, 1.0),
         size=(size[0], size[1], size[2]),
         up=up,
+        up_from=up_from,
         units=units,
         footprint=_hull(local[:, :2]),
         surfaces=_surfaces(local, faces),
@@ -197,11 +213,22 @@ def _read_cached(
     )
 
 
+def orientation_warning(class_name: str, assets: tuple[MeshAsset, ...]) -> str | None:
+    """A warning when the variants of one class were read with different up axes and one of
+    them was measured (it may lie on its side), naming each file's axis and how it was
+    decided; files whose axis their format or entry fixes are taken at their word."""
+    if len({a.up for a in assets}) < 2 or all(a.up_from != "measured" for a in assets):
+        return None
+    read = ", ".join(f"{Path(a.path).name}: {a.up.upper()} ({a.up_from})" for a in assets)
+    return (
+        f"class {class_name}'s files disagree on the up axis ({read}); if one lies on its "
+        'side, give up = "y" or "z" in the class entry (or re-export it)'
+    )
+
+
 def _declared(raw: RawMesh, source: MeshSource) -> MeshSource:
     """``source`` with the up axis and unit a file declares (USD's upAxis, metersPerUnit)
     where the class entry leaves them to be measured."""
-    import dataclasses
-
     changes = {}
     if raw.up is not None and source.up == "auto":
         changes["up"] = raw.up

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cache
 from importlib import resources
 from pathlib import Path
@@ -12,7 +12,7 @@ from sgdata.errors import CatalogError
 from sgdata.fileio import read_toml
 from sgdata.world.catalog import Catalog
 
-__all__ = ["ROOM_TYPES", "CountedClass", "RoomRecipe", "load_room_recipes"]
+__all__ = ["ROOM_TYPES", "CountedClass", "RoomRecipe", "load_room_recipes", "never_placed"]
 
 ROOM_TYPES = ("kitchen", "living_room", "bedroom", "bathroom")
 SIDES = ("any", "front", "sides")
@@ -67,7 +67,52 @@ def _load(path: str, catalog: Catalog) -> dict[str, RoomRecipe]:
     missing = [t for t in ROOM_TYPES if t not in table]
     if missing:
         raise CatalogError(f"{path}: no [room_types.{missing[0]}] table")
-    return {t: _parse(path, t, table[t], catalog) for t in ROOM_TYPES}
+    recipes = {t: _parse(path, t, table[t], catalog) for t in ROOM_TYPES}
+    return {t: _with_catalog_rooms(recipe, catalog) for t, recipe in recipes.items()}
+
+
+# Which list of a recipe places a class of each placement kind
+_LIST_OF_PLACEMENT = {
+    "floor": "furniture",
+    "wall_floor": "furniture",
+    "wall": "wall_items",
+    "surface": "small",
+}
+
+
+def _with_catalog_rooms(recipe: RoomRecipe, catalog: Catalog) -> RoomRecipe:
+    """``recipe`` with the classes whose catalog entry names its room type in ``rooms``
+    appended to the list their placement kind fills (after the recipe's own, so a recipe
+    without such classes draws exactly as before)."""
+    added: dict[str, list[CountedClass]] = {}
+    for spec in catalog.classes.values():
+        for room_type, low, high in spec.rooms:
+            if room_type not in ROOM_TYPES:
+                raise CatalogError(
+                    f"{catalog.source}: class {spec.name}: field 'rooms' names room type "
+                    f"{room_type!r}; expected one of {', '.join(ROOM_TYPES)}"
+                )
+            if room_type == recipe.room_type:
+                key = _LIST_OF_PLACEMENT[spec.placement]
+                added.setdefault(key, []).append(CountedClass(spec.name, (low, high)))
+    if not added:
+        return recipe
+    lists = {key: (*getattr(recipe, key), *items) for key, items in added.items()}
+    return replace(recipe, **lists)
+
+
+def never_placed(catalog: Catalog) -> list[str]:
+    """The classes a user catalog adds to the shipped ones that no room recipe places (a run,
+    a wall item, furniture or a small object; parts come only with their owners): they can
+    appear in your own rooms only."""
+    from sgdata.world.catalog import load_catalog
+
+    shipped = load_catalog()
+    placed = set()
+    for recipe in load_room_recipes(catalog).values():
+        placed.update(name for run in recipe.runs for name in run)
+        placed.update(i.class_name for i in (*recipe.wall_items, *recipe.furniture, *recipe.small))
+    return [name for name in catalog.classes if name not in shipped and name not in placed]
 
 
 def _parse(path: str, room_type: str, entry: dict[str, Any], catalog: Catalog) -> RoomRecipe:

@@ -50,6 +50,22 @@ def test_a_new_class_gets_bounds_from_its_files(tmp_path: Path) -> None:
     entry = tomllib.loads((tmp_path / "catalog.toml").read_text())["classes"]["Charger"]
     assert entry["size_min"] == [0.216, 0.216, 0.018]
     assert entry["receptacles"] == ["DiningTable"]
+    assert "appears: in no generated room" in done.stdout and "--rooms" in done.stdout
+    # --rooms puts it into the kitchen recipe, and says where it will stand
+    done = run(
+        "assets", "add", "plates", "--class", "Charger", "--dynamics", "high",
+        "--placement", "surface", "--on", "DiningTable", "--rooms", "kitchen:1-2", cwd=tmp_path,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    entry = tomllib.loads((tmp_path / "catalog.toml").read_text())["classes"]["Charger"]
+    assert entry["rooms"] == {"kitchen": [1, 2]} and entry["max_instances"] == 2
+    assert "appears: kitchen rooms (1-2 per room, on DiningTable)" in done.stdout
+    done = run(
+        "assets", "add", "plates", "--class", "Charger", "--dynamics", "high",
+        "--placement", "surface", "--on", "DiningTable", "--rooms", "garage", cwd=tmp_path,
+    )  # fmt: skip
+    assert done.returncode == 2 and "'garage'" in done.stderr
+    assert tomllib.loads((tmp_path / "catalog.toml").read_text())["classes"]["Charger"] == entry
 
 
 def test_a_bad_mesh_is_one_line_and_leaves_the_catalog(tmp_path: Path) -> None:

@@ -280,6 +280,8 @@ def test_the_covisibility_oracle_is_recorded_and_shown_beside_the_methods(
     section = text.split("## What the views can decide")[1].split("\n## ")[0]
     assert "| all |  | " + str(n) + " | " in section
     assert "`tiny-image` %" in section and "`resnet18+boxes` %" in section
+    aim = section.split("What this says of the 90 % aim:")[1]
+    assert "On the triplets the views decide" in aim and "The aim stays 90 %" in aim
     assert (docs / "images" / "covisibility-disagreements.png").is_file()
 
 

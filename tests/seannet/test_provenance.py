@@ -16,19 +16,13 @@ from seannet.provenance import (
     read_provenance,
     stamp,
 )
+from sgdata.dataset import Dataset
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def _manifest(root: Path) -> Path:
-    root.mkdir()
-    manifest = {"format": "sgdata", "format_version": "2.0.1", "config": {"dataset": {"seed": 7}}}
-    (root / "dataset.json").write_text(json.dumps(manifest))
-    return root
-
-
-def test_records_are_appended_and_each_is_named(tmp_path: Path) -> None:
-    data = _manifest(tmp_path / "data")
+def test_records_are_appended_and_each_is_named(tmp_path: Path, mini_dataset: Path) -> None:
+    data, manifest = mini_dataset, Dataset.open(mini_dataset).manifest
     run = tmp_path / "run"
     first = append_provenance(run, data, step="train")
     second = append_provenance(run, data, step="resume")
@@ -36,11 +30,14 @@ def test_records_are_appended_and_each_is_named(tmp_path: Path) -> None:
     assert [json.loads(line)["step"] for line in lines] == ["train", "resume"]
     assert read_provenance(run) == [first, second]
     assert read_provenance(run, "resume") == [second]
-    assert first["commit"] == PROCESS.commit and first["format_version"] == "2.0.1"
-    assert first["dataset_seed"] == 7 and len(first["manifest_sha256"]) == 64
+    assert first["commit"] == PROCESS.commit
+    assert first["format_version"] == manifest.format_version
+    assert first["dataset_seed"] == manifest.seed and len(first["manifest_sha256"]) == 64
+    assert first["recipe"] == manifest.recipe_fingerprint()  # the identity that travels
     text = stamp(read_provenance(run))
     assert text.startswith("*Made by 2 commands:")
     assert text.count(first["manifest_sha256"][:16]) == 2
+    assert text.count(f"recipe `{first['recipe'][:16]}") == 2
     # a killed writer's torn last line is skipped
     with open(run / PROVENANCE, "a") as f:
         f.write('{"step": "tr')

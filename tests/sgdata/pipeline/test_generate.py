@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -165,3 +166,43 @@ def test_sigkill_mid_run_then_resume(
     resumed = subprocess.run([*command, "--resume"], capture_output=True, text=True, timeout=600)
     assert resumed.returncode == 0, resumed.stderr
     assert digest_tree(root) == digest_tree(mini_dataset)
+
+
+def test_a_worker_dead_of_a_signal_is_one_line_then_resume(
+    tmp_path: Path, mini_dataset: Path, mini_config_file: Path, procs
+) -> None:
+    """A pool worker killed with SIGSEGV (what a crash in the GL driver looks like) ends the
+    run in one line naming the worker, the signal and its room; --resume finishes it with
+    the same bytes. One worker, so that it is rendering the second room when it is killed."""
+    root = tmp_path / "crashed"
+    command = [sys.executable, "-m", "sgdata_cli.sgdata_app", "generate"]
+    command += [str(mini_config_file), str(root), "--workers", "1"]
+    process = subprocess.Popen(
+        command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True
+    )
+    deadline = time.monotonic() + 240
+    while not list((root / LEDGER).glob("views-*.json")):
+        assert process.poll() is None, process.stderr.read().decode() if process.stderr else ""
+        assert time.monotonic() < deadline, "no room finished in time"
+        time.sleep(0.05)
+    (worker,) = [p for p in procs.in_session(process.pid) if b"spawn_main" in _cmdline(p)]
+    os.kill(worker, signal.SIGSEGV)
+    _, stderr = process.communicate(timeout=120)
+    lines = stderr.decode().strip().splitlines()
+    assert process.returncode == 2, stderr
+    assert len(lines) == 1, stderr
+    assert re.search(
+        rf"error: worker {worker} died of SIGSEGV while on room bathroom_\d+; rerun with --resume$",
+        lines[0],
+    ), lines[0]
+    assert procs.wait_until_gone(lambda: procs.in_session(process.pid)) == []
+    resumed = subprocess.run([*command, "--resume"], capture_output=True, text=True, timeout=600)
+    assert resumed.returncode == 0, resumed.stderr
+    assert digest_tree(root) == digest_tree(mini_dataset)
+
+
+def _cmdline(pid: int) -> bytes:
+    try:
+        return Path(f"/proc/{pid}/cmdline").read_bytes()
+    except OSError:
+        return b""

@@ -4,13 +4,16 @@ and recorded (sha256 in the manifest, ``validate --sources``), and bad assets re
 from __future__ import annotations
 
 import hashlib
+import io
 import json
 import os
 import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pyarrow.parquet as pq
+from PIL import Image
 
 from sgdata.pipeline.config import load_config
 from tests.asset_meshes import write_demo_assets
@@ -38,8 +41,23 @@ train = 10
 val = 0
 test = 0
 
+[outputs]
+instances = true
+
 [catalog]
 files = ["catalog.toml"]
+"""
+# a new class (none of the shipped ones) that the kitchen recipe places, two per room
+NEW_CLASS = """
+[classes.Charger]
+mesh = "meshes/plate*.stl"
+dynamics = "high"
+placement = "surface"
+receptacles = ["CounterTop", "DiningTable"]
+size_min = [0.2, 0.2, 0.01]
+size_max = [0.3, 0.3, 0.03]
+max_instances = 2
+rooms = { kitchen = [2, 2] }
 """
 
 
@@ -59,6 +77,8 @@ def digest_tree(root: Path) -> dict[str, str]:
 def test_generate_with_mesh_classes_end_to_end(tmp_path: Path) -> None:
     project = tmp_path / "project"
     write_demo_assets(project)
+    with open(project / "catalog.toml", "a", encoding="utf-8") as catalog:
+        catalog.write(NEW_CLASS)
     config = project / "config.toml"
     config.write_text(CONFIG, encoding="utf-8")
     one, two = tmp_path / "one", tmp_path / "two"
@@ -93,6 +113,20 @@ def test_generate_with_mesh_classes_end_to_end(tmp_path: Path) -> None:
                 assert (obj["instance"], support["instance"], on) in relations
                 seen_on_table += 1
     assert seen_on_table > 0  # things rest on the mesh table's measured top
+    # the new class is in the room and in views, with a box and its own mask pixels
+    chargers = [
+        (row, k)
+        for row in rows
+        for k, o in enumerate(row["objects"])
+        if o["class_name"] == "Charger"
+    ]
+    assert chargers, "the new class appears in no view"
+    for row, k in chargers:
+        u1, v1, u2, v2 = row["objects"][k]["box2d"]
+        mask = np.asarray(Image.open(io.BytesIO(row["instances"]["bytes"])))
+        rows_, cols = np.nonzero(mask == k + 1)
+        assert len(rows_) == row["objects"][k]["visible_pixels"]
+        assert (cols.min(), rows_.min(), cols.max() + 1, rows_.max() + 1) == (u1, v1, u2, v2)
 
     # relations re-computable from the stored boxes and supports (every pair agrees)
     checked = run_cli("sgdata", "validate", str(one), "--sources", str(project))
@@ -140,3 +174,20 @@ def test_the_demo_config_names_the_demo_catalog() -> None:
     config = load_config(Path(__file__).parents[3] / "configs" / "assets.toml")
     assert config.catalog.files == ("demo_assets/catalog.toml",)
     assert config.catalog.paths()[0].parent.name == "demo_assets"
+
+
+def test_a_new_class_no_room_recipe_places_is_warned_about(tmp_path: Path) -> None:
+    project = tmp_path / "project"
+    write_demo_assets(project)
+    with open(project / "catalog.toml", "a", encoding="utf-8") as catalog:
+        catalog.write(NEW_CLASS.replace("rooms = { kitchen = [2, 2] }\n", ""))
+    config = project / "config.toml"
+    config.write_text(CONFIG, encoding="utf-8")
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "dataset.json").write_text("{}")  # generate refuses it: only the warning runs
+    done = run("generate", str(config), str(out))
+    assert done.returncode == 2
+    assert "warning: class Charger is in your catalog but no room recipe places it" in " ".join(
+        done.stdout.split()
+    )

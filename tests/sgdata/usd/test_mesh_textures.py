@@ -19,7 +19,7 @@ from sgdata.world.appearance import AppearanceConfig
 from sgdata.world.catalog import load_catalog
 from sgdata.world.mesh_assets import class_assets
 from sgdata.world.rooms import generate_room
-from tests.asset_meshes import plate, write_demo_assets
+from tests.asset_meshes import Y_UP, plate, write_demo_assets
 
 
 @pytest.fixture(scope="module")
@@ -37,6 +37,7 @@ def demo(tmp_path_factory: pytest.TempPathFactory) -> Path:
         baseColorTexture=Image.fromarray(pixels), baseColorFactor=[255, 128, 255, 255]
     )
     mesh.visual = trimesh.visual.TextureVisuals(uv=uv, material=material)
+    mesh.apply_transform(Y_UP)  # glTF is Y up by its specification
     (folder / "meshes" / "plate.stl").unlink()
     (folder / "meshes" / "plate.glb").write_bytes(mesh.export(file_type="glb"))
     text = (folder / "catalog.toml").read_text(encoding="utf-8")

@@ -6,13 +6,19 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import trimesh
 
 from sgdata.errors import CatalogError
 from sgdata.world.catalog import load_catalog
-from sgdata.world.mesh_assets import asset_files, class_assets, class_shape
+from sgdata.world.mesh_assets import (
+    asset_files,
+    class_assets,
+    class_shape,
+    orientation_warning,
+)
 from sgdata.world.rooms import generate_room
 from sgdata.world.shapes import merged_mesh
-from tests.asset_meshes import bowl, plate, write_demo_assets
+from tests.asset_meshes import bowl, plate, table, write_demo_assets
 
 DEMO = ("DiningTable", "Mug", "Bowl", "Plate")
 
@@ -208,3 +214,30 @@ def test_recipe_fields_are_refused_on_a_mesh_class(tmp_path: Path) -> None:
     user = _catalog_with(tmp_path, 'mesh = "p.stl"\nshape = "plate"')
     with pytest.raises(CatalogError, match="'shape' is for recipe classes"):
         load_catalog(extra=[user])
+
+
+def test_the_up_axis_is_said_glb_by_its_format_obj_measured(tmp_path: Path) -> None:
+    """One Z-up table written as .glb (glTF is Y up by its specification, so the file is
+    read as such, never guessed) and as .obj (no convention: measured). Either both come out
+    with one up axis, or the class gets a warning naming each file's axis and its source."""
+    geometry = trimesh.util.concatenate(table())
+    folder = tmp_path / "tables"
+    folder.mkdir()
+    (folder / "table.glb").write_bytes(geometry.export(file_type="glb"))
+    (folder / "table.obj").write_text(geometry.export(file_type="obj"), encoding="utf-8")
+    entry = 'mesh = "tables/table.*"'
+    catalog = load_catalog(extra=[_catalog_with(tmp_path, entry, "DiningTable")])
+    glb, obj = sorted(class_assets(catalog["DiningTable"]), key=lambda a: a.path)
+    assert (glb.up, glb.up_from) == ("y", "format")
+    assert obj.up_from == "measured"
+    warning = orientation_warning("DiningTable", (glb, obj))
+    if glb.up == obj.up:
+        assert warning is None
+    else:
+        assert warning is not None
+        assert "table.glb: Y (format)" in warning and f"table.obj: {obj.up.upper()}" in warning
+    # an axis the class entry gives is taken as given, for every file
+    given = load_catalog(extra=[_catalog_with(tmp_path, entry + '\nup = "z"', "DiningTable")])
+    assets = class_assets(given["DiningTable"])
+    assert {(a.up, a.up_from) for a in assets} == {("z", "given")}
+    assert orientation_warning("DiningTable", assets) is None
