@@ -477,6 +477,7 @@ def benchmark(
     markdown, sweep plot)."""
     from functools import partial
 
+    from seannet.data.opening import open_dataset
     from seannet.methods.benchmark import BenchmarkConfig, benchmark_method
     from seannet.navigation.method_navigation import navigation_test
 
@@ -494,9 +495,10 @@ def benchmark(
         navigation = partial(
             navigation_test, navigator=navigator, data=data, config=test, workers=workers
         )
+    dataset = open_dataset(data)  # every method's seeds, saved method and card share it
     for name in [m.strip() for m in methods.split(",") if m.strip()]:
         card = benchmark_method(
-            name, data, out, config, announce=console.print, navigation=navigation
+            name, dataset, out, config, announce=console.print, navigation=navigation
         )
         typer.echo(card.with_name("card.md").read_text())
         console.print(f"wrote {card} and its .md, sweep.png")

@@ -43,7 +43,8 @@ from torch import Tensor
 from torch.utils.data import DataLoader
 
 from seannet.data.box_noise import BoxNoise
-from seannet.data.datasets import ImageTransform, ObservationDataset, collate_views, open_dataset
+from seannet.data.datasets import ImageTransform, ObservationDataset, collate_views
+from seannet.data.opening import DataSource, open_dataset
 from seannet.errors import MethodError
 from seannet.evaluation.intervals import (
     per_room_matrix,
@@ -64,6 +65,7 @@ from seannet.methods.registry import load_method
 from seannet.methods.views import Budget, SplitData
 from seannet.seeds import DEFAULT_SEEDS
 from seannet.training.config import DEFAULT_PRESET
+from sgdata.dataset import Dataset
 
 __all__ = [
     "BenchmarkConfig",
@@ -124,9 +126,8 @@ class _Embedded:
 class _Harness:
     """One method on one dataset: views in the method's transform, checked outputs."""
 
-    def __init__(self, name: str, method: Any, data: Path, config: BenchmarkConfig) -> None:
-        self.name, self.method, self.data, self.config = name, method, data, config
-        self.dataset = open_dataset(data)  # the manifest and triplet tables, read once
+    def __init__(self, name: str, method: Any, dataset: Dataset, config: BenchmarkConfig) -> None:
+        self.name, self.method, self.dataset, self.config = name, method, dataset, config
         self.width: int | None = None
         self.similarity = getattr(method, "similarity", None)
 
@@ -177,7 +178,7 @@ class _Harness:
             return (batch for batch, _ in loader)
 
         tiers = table.column("tier").to_numpy().astype(np.int64)
-        return SplitData(split, self.data, triplets, tiers, len(views), batches, self.name)
+        return SplitData(split, self.dataset, triplets, tiers, len(views), batches, self.name)
 
     def scores(self, vectors: Tensor, first: np.ndarray, second: np.ndarray) -> np.ndarray:
         """(P,) similarity of the row pairs, checked."""
@@ -268,16 +269,17 @@ def _triplets(h: _Harness, e: _Embedded, split: str) -> tuple[np.ndarray, dict[s
 
 
 def run_seed(
-    name: str, factory: Callable[[], Any], data: Path, config: BenchmarkConfig, seed: int,
+    name: str, factory: Callable[[], Any], data: DataSource, config: BenchmarkConfig, seed: int,
     work: Path, say: Callable[[str], None],
 ) -> tuple[dict[str, Any], Any]:  # fmt: skip
-    """The protocol for one seed: its results, and the (fitted) method. Its val triplet
-    accuracy (``val_accuracy``) is what a choice between runs reads; test is read here once."""
+    """The protocol for one seed on ``data`` (an opened dataset, or its root: opened here):
+    its results, and the (fitted) method. Its val triplet accuracy (``val_accuracy``) is what
+    a choice between runs reads; test is read here once."""
     torch.manual_seed(seed)
     method = guarded(name, "its factory", factory)
     if not callable(getattr(method, "embed", None)):
         raise MethodError(f"method {name!r}: has no embed(views) (check: interface)")
-    h = _Harness(name, method, data, config)
+    h = _Harness(name, method, open_dataset(data), config)
     fit = getattr(method, "fit", None)
     fitting = time.perf_counter()
     if fit is not None:
@@ -413,14 +415,16 @@ def summarize(runs: list[dict[str, Any]]) -> dict[str, Any]:
 
 def benchmark_method(
     name: str,
-    data: Path,
+    data: DataSource,
     out: Path,
     config: BenchmarkConfig = BenchmarkConfig(),
     *,
     announce: Callable[[str], None] | None = None,
     navigation: Callable[[Path], dict[str, Any]] | None = None,
 ) -> Path:
-    """Run the protocol for one method and write its card under ``out``; the card's JSON path.
+    """Run the protocol for one method on ``data`` (an opened dataset, or its root: opened
+    once here, for every seed, the saved method and the card) and write its card under
+    ``out``; the card's JSON path.
 
     Args:
         navigation: the navigation test of a method directory (the first seed's method, saved
@@ -435,18 +439,21 @@ def benchmark_method(
 
     say = announce or (lambda _text: None)
     factory, _ = load_method(name)
+    dataset = open_dataset(data)
     work = out / "runs"
-    first, method = run_seed(name, factory, data, config, config.seeds[0], work, say)
+    first, method = run_seed(name, factory, dataset, config, config.seeds[0], work, say)
     runs = [first]
     trained = first["trained"]  # a method with fit() trains once per seed
     if trained:
-        runs += [run_seed(name, factory, data, config, s, work, say)[0] for s in config.seeds[1:]]
+        runs += [
+            run_seed(name, factory, dataset, config, s, work, say)[0] for s in config.seeds[1:]
+        ]
     summary = summarize(runs)
     directory = card_dir(out, name)
     directory.mkdir(parents=True, exist_ok=True)
     save_method(directory, name, method, epsilon=first["threshold"]["epsilon"],
-                epsilon_source=f"val (benchmark, seed {first['seed']})", data=data)  # fmt: skip
+                epsilon_source=f"val (benchmark, seed {first['seed']})", data=dataset)  # fmt: skip
     if navigation is not None:
         say(f"{name}: navigation test, seed {first['seed']}")
         summary["navigation"] = navigation(directory)
-    return write_card(directory, name, data, config, runs, summary, trained=trained)
+    return write_card(directory, name, dataset, config, runs, summary, trained=trained)

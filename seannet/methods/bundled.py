@@ -22,6 +22,7 @@ from seannet.training.config import DEFAULT_PRESET
 from seannet.training.config import preset as load_preset
 from seannet.training.runs import LAST, restore_run
 from seannet.training.train import train
+from sgdata.dataset import Dataset
 
 __all__ = ["NetworkMethod", "embed_split_views", "pair_scores"]
 
@@ -85,23 +86,23 @@ class NetworkMethod:
         for lr in budget.lrs or (self.config.lr,):
             run = work / spec.trained / f"lr{lr:g}" / f"seed{budget.seed}"
             config = self.config.replace(lr=lr)
-            train(config, train_split.root, run, resume=(run / LAST).exists(),
+            train(config, train_split.dataset, run, resume=(run / LAST).exists(),
                   pretrained=spec.pretrained)  # fmt: skip
-            self._restore(run, train_split.root)
+            self._restore(run, train_split.dataset)
             vectors = embed_split_views(self, val)
             s_ap, s_an = pair_scores(self, vectors, val.triplets)
             by_lr[f"{lr:g}"] = float((s_ap > s_an).float().mean())
             if best is None or (by_lr[f"{lr:g}"], -lr) > best[:2]:
                 best = (by_lr[f"{lr:g}"], -lr, run)
         assert best is not None
-        self._restore(best[2], train_split.root)
+        self._restore(best[2], train_split.dataset)
         self.choices = {"lr": -best[1], "val_accuracy_by_lr": by_lr, "run": str(best[2])}
         if self.scene.term:
             self.fit_scene(train_split, val)
             self.choices.update(self.scene.choices)
 
-    def _restore(self, run: Path, root: Path) -> None:
-        restored = restore_run(run, root)
+    def _restore(self, run: Path, dataset: Dataset) -> None:
+        restored = restore_run(run, dataset)
         self.model, self.device = restored.model, restored.device
 
     def fit_scene(self, train: SplitData, val: SplitData) -> None:

@@ -14,7 +14,7 @@ import math
 import re
 from dataclasses import asdict
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from PIL import Image, ImageDraw, ImageFont
 
@@ -22,6 +22,9 @@ from seannet.errors import MethodError
 from seannet.markdown import pct, table
 from seannet.provenance import provenance_record
 from sgdata.fileio import atomic_write_text, save_png
+
+if TYPE_CHECKING:
+    from sgdata.dataset import Dataset
 
 __all__ = [
     "CARD",
@@ -245,14 +248,15 @@ def _plot(card: dict[str, Any]) -> Image.Image:
 def write_card(
     directory: Path,
     name: str,
-    data: Path,
+    data: Path | Dataset,
     config: Any,
     runs: list[dict[str, Any]],
     summary: dict[str, Any],
     *,
     trained: bool,
 ) -> Path:
-    """Write ``card.json``, ``card.md`` and ``sweep.png`` (each atomically); the JSON path."""
+    """Write ``card.json``, ``card.md`` and ``sweep.png`` (each atomically); the JSON path.
+    ``data`` (opened, or its root) is stamped in the card's provenance."""
     card = {
         "card": 1,
         "method": name,

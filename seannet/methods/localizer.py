@@ -37,7 +37,7 @@ import torch
 import torch.nn.functional as F
 
 from seannet.data.collate import ViewTensors, collate_views
-from seannet.data.opening import dataset_identity
+from seannet.data.opening import DataSource, dataset_identity
 from seannet.data.view_inputs import ImageTransform
 from seannet.errors import MethodError
 from seannet.methods.checks import (
@@ -155,7 +155,7 @@ def save_method(
     *,
     epsilon: float,
     epsilon_source: str,
-    data: Path,
+    data: DataSource,
 ) -> Path:
     """Write ``method.json`` (and, for a method with ``fit``, ``method.pt``: its
     ``state_dict()``) into ``directory``, so that :func:`open_method` gives the same localizer

@@ -26,8 +26,6 @@ from seannet.methods.boxes import box_scores, box_vectors, row_triplets, vector_
 from seannet.methods.views import Budget, SplitData, Views
 from seannet.model.loss import TripletLoss
 from seannet.weights import IMAGE_SIZE, LITE0, LITE0_WEIGHTS
-from sgdata.dataset.paths import MANIFEST
-from sgdata.fileio import sha256_file
 
 __all__ = [
     "BoxKernelMethod",
@@ -96,8 +94,8 @@ class Lite0GeMHead(Lite0GeM):
 
     def _frozen_inputs(self, split: SplitData) -> Tensor:
         """:meth:`_pooled` of ``split``, computed once per dataset (its manifest's sha256)."""
-        dataset = (type(self).__name__, str(split.root.resolve()),
-                   sha256_file(split.root / MANIFEST)[0])  # fmt: skip
+        dataset = (type(self).__name__, str(split.dataset.root.resolve()),
+                   split.dataset.manifest_sha256)  # fmt: skip
         key = (*dataset, split.name)
         if key not in Lite0GeMHead._frozen:
             if any(k[:3] != dataset for k in Lite0GeMHead._frozen):

@@ -6,6 +6,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from torch import Tensor
@@ -13,6 +14,9 @@ from torch import Tensor
 from seannet.data.batch import SceneBatch
 from seannet.errors import MethodError
 from seannet.training.config import DEFAULT_PRESET
+
+if TYPE_CHECKING:
+    from sgdata.dataset import Dataset
 
 __all__ = ["HIDDEN_FIELDS", "Budget", "SplitData", "Views"]
 
@@ -133,12 +137,14 @@ class Budget:
 class SplitData:
     """One split of the dataset for ``fit``: its views in batches and its triplets.
 
-    ``triplets`` index :meth:`views`' order. ``root`` is the dataset, for trainers that read it
-    their own way (the bundled networks); the views and triplets are all a method needs.
+    ``triplets`` index :meth:`views`' order. ``dataset`` is the dataset the benchmark opened
+    (its directory ``dataset.root``), for trainers that read it their own way (the bundled
+    networks): they take the handle rather than reading its ``dataset.json`` again. The views
+    and triplets are all a method needs.
     """
 
     name: str
-    root: Path
+    dataset: Dataset
     triplets: np.ndarray  # (T, 3) int64: anchor, positive, negative view indices
     tiers: np.ndarray  # (T,) int64
     count: int  # views in the split

@@ -150,9 +150,7 @@ def _evaluate(
         lrs=(unit.lr,) if unit.lr is not None else (),
         noise=evaluation.noise,
     )
-    result, method = run_seed(
-        evaluation.method, factory, ds.root, config, unit.seed, work / "runs", say
-    )
+    result, method = run_seed(evaluation.method, factory, ds, config, unit.seed, work / "runs", say)
     choices = dict(result.get("choices", {}))
     choices.pop("run", None)  # a path of this machine's work folder, gone with the unit
     result["choices"] = choices
@@ -202,7 +200,7 @@ def _full_map(
     directory = work / "fullmap" / method_label(name)
     directory.mkdir(parents=True, exist_ok=True)
     save_method(directory, name, method, epsilon=result["threshold"]["epsilon"],
-                epsilon_source="val (protocol unit)", data=ds.root)  # fmt: skip
+                epsilon_source="val (protocol unit)", data=ds)  # fmt: skip
     localizer = open_localizer(directory, ds.root, require_epsilon=False)
     rooms = list(ds.rooms("test"))
     build_maps(localizer, ds.root, rooms, directory / "maps", spacing=design.map_spacing)

@@ -1,6 +1,6 @@
 """A command opens its dataset once (STYLE.md habit 15): ``dataset.json`` is read one time per
-``compare``, ``eval``, ``train`` or ``train-navigator``, however many loaders, checkpoints and
-records sit below."""
+``benchmark``, ``compare``, ``eval``, ``train`` or ``train-navigator``, however many loaders,
+checkpoints and records sit below."""
 
 from __future__ import annotations
 
@@ -17,6 +17,7 @@ from seannet.evaluation.run_eval import evaluate_run
 from seannet.training.config import TrainConfig
 from seannet.training.train import train
 from sgdata.dataset.paths import MANIFEST
+from tests.cli_runner import run_cli
 
 TINY = TrainConfig().replace(
     model="resnet18",
@@ -95,4 +96,18 @@ def test_train_navigator_reads_the_manifest_once(
         image_size=64, hidden=16, epochs=1, batch_size=8, train_pairs=8, val_pairs=4
     )
     train_navigator(config, mini_dataset, tmp_path / "nav")
+    assert manifest_reads.of(mini_dataset) == 1
+
+
+def test_benchmark_reads_the_manifest_once(
+    tmp_path: Path, mini_dataset: Path, manifest_reads: ManifestReads
+) -> None:
+    # a frozen baseline and a bundled network: the harness's loaders, the network's training
+    # (identity, checkpoints, its lambda on val), the moved objects, the saved method, the card
+    done = run_cli(
+        "seannet", "benchmark", "--data", mini_dataset, "--methods", "tiny-image,resnet18+boxes",
+        "--out", tmp_path / "cards", "--seeds", "0", "--batches", "1", "--epochs", "1",
+        "--lrs", "0.01",
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
     assert manifest_reads.of(mini_dataset) == 1

@@ -102,7 +102,7 @@ def _split(data: Path, name: str, size: int, method: str) -> SplitData:
         return (batch for batch, _ in loader)
 
     tiers = table.column("tier").to_numpy().astype(np.int64)
-    return SplitData(name, data, triplets, tiers, len(views), batches, method)
+    return SplitData(name, dataset, triplets, tiers, len(views), batches, method)
 
 
 def _user_method(tmp_path: Path, *, state: bool = True) -> str:
