@@ -48,6 +48,8 @@ from seannet.training.budget import calibrate
 from seannet.training.config import DEFAULT_PRESET, TrainConfig, preset
 from seannet.training.loop import train_one_epoch, triplet_step
 from seannet.training.runs import build_for_dataset
+from seannet.training.step_table import step_table
+from sgdata.markdown import table
 
 # the networks docs/results.md trains (a scene term adds no training step), ResNet-18 first
 RESULTS_NETWORKS = tuple(
@@ -128,19 +130,12 @@ def step_costs(
 
 def step_report(figures: dict[str, Any]) -> str:
     """:func:`step_costs` as a markdown table."""
-    first = figures["networks"][0]["network"]
     lines = [
         f"A training step of {figures['batch_size']} triplets, timed by the budget's rule "
         f"({figures['clock']}); batches per epoch that {figures['budget_s']:g} s buy over "
         f"{figures['epochs']} epochs",
         "",
-        f"| network | step s | x {first} | spread | busy | batches per epoch |",
-        "|---|---|---|---|---|---|",
-    ]
-    lines += [
-        f"| `{r['network']}` | {r['step_s']:.3f} | {r['step_ratio']:.2f}x | "
-        f"{100 * r['spread']:.0f} % | {100 * r['busy']:.0f} % | {r['batches']} |"
-        for r in figures["networks"]
+        *step_table(figures["networks"]),
     ]
     return "\n".join(lines)
 
@@ -418,17 +413,29 @@ def profile_report(result: dict, config: Any) -> str:
         f"{result['forward_s']:.3f} s, backward {result['backward_s']:.3f} s, optimiser "
         f"{result['optimiser_s']:.3f} s)",
         "",
-        "| part | forward ms | backward ms | total ms | share | parameters |",
-        "|---|---|---|---|---|---|",
     ]
-    for p in result["parts"]:
-        lines.append(
-            f"| {p['label']} | {1000 * p['forward_s']:.1f} | {1000 * p['backward_s']:.1f} | "
-            f"{1000 * p['total_s']:.1f} | {100 * p['share']:.1f} % | {p['parameters']:,} |"
+    rows = [
+        (
+            p["label"],
+            f"{1000 * p['forward_s']:.1f}",
+            f"{1000 * p['backward_s']:.1f}",
+            f"{1000 * p['total_s']:.1f}",
+            f"{100 * p['share']:.1f} %",
+            f"{p['parameters']:,}",
         )
+        for p in result["parts"]
+    ]
+    step = (
+        "**step**",
+        f"**{1000 * result['forward_s']:.1f}**",
+        f"**{1000 * result['backward_s']:.1f}**",
+        f"**{1000 * result['step_s']:.1f}**",
+        "100 %",
+        f"**{result['parameters']:,}**",
+    )
+    header = ("part", "forward ms", "backward ms", "total ms", "share", "parameters")
     lines += [
-        f"| **step** | **{1000 * result['forward_s']:.1f}** | **{1000 * result['backward_s']:.1f}**"
-        f" | **{1000 * result['step_s']:.1f}** | 100 % | **{result['parameters']:,}** |",
+        *table(header, [*rows, step]),
         "",
         f"backward booked to a part: {100 * result['backward_attributed']:.1f} % (the rest: the "
         "autograd engine, gradient accumulation); times under torch.profiler, which adds a "
