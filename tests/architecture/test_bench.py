@@ -16,6 +16,8 @@ ROOT = Path(__file__).resolve().parents[2]
 BENCH = ROOT / "bench"
 # never importable from a bench script, whatever the environment installs under the name
 NOT_INSTALLED = ("tests", "conftest", "bench")
+# the project's own packages: a script uses their public names only
+PACKAGES = ("sgdata", "seannet", "sgdata_cli")
 # run-time loaders: a script that needs one is reaching for code the package does not offer
 LOADERS = ("import_module", "__import__", "spec_from_file_location", "run_path", "run_module")
 
@@ -35,7 +37,8 @@ def _installed() -> frozenset[str]:
 def bench_problems(folder: Path, installed: frozenset[str]) -> list[str]:
     """What makes a script of ``folder`` more than a thin one, one line each: a ``sys.path``
     or ``site.addsitedir`` edit, an import of a sibling script, of the tests or of a module
-    not ``installed``, a run-time loader. Relative imports count as sibling imports."""
+    not ``installed``, a private name of the project's packages, a run-time loader. Relative
+    imports count as sibling imports."""
     siblings = {p.stem for p in folder.glob("*.py")}
     problems = []
     for path in sorted(folder.glob("*.py")):
@@ -49,6 +52,9 @@ def bench_problems(folder: Path, installed: frozenset[str]) -> list[str]:
                     problems.append(f"{where}:{node.lineno}: relative import (a sibling)")
                     continue
                 names = [node.module or ""]
+                private = [a.name for a in node.names if a.name.startswith("_")]
+                if private and names[0].partition(".")[0] in PACKAGES:
+                    problems.append(f"{where}:{node.lineno}: imports private {', '.join(private)}")
                 if node.module == "sys" and any(a.name == "path" for a in node.names):
                     problems.append(f"{where}:{node.lineno}: sys.path")
             elif isinstance(node, ast.Attribute) and node.attr == "path":
@@ -90,6 +96,7 @@ def test_bench_scripts_import_only_installed_packages() -> None:
             "bad.py:2: spec_from_file_location",
         ),
         ("import runpy\nrunpy.run_path('good.py')\n", "bad.py:2: run_path"),
+        ("from sgdata.render.renderer import _rot_x\n", "bad.py:1: imports private _rot_x"),
     ],
     ids=[
         "sys.path",
@@ -103,6 +110,7 @@ def test_bench_scripts_import_only_installed_packages() -> None:
         "import_module",
         "spec_from_file_location",
         "run_path",
+        "private name",
     ],
 )
 def test_a_script_that_is_not_thin_is_found(tmp_path: Path, script: str, problem: str) -> None:
