@@ -436,12 +436,10 @@ def markdown(results: dict[str, Any]) -> str:
             "t-interval:",
             "",
         ]
-        differences = [
-            e["difference_to_first"] | {"model": e["model"]} for e in results["models"][1:]
-        ]
+        differences = [(e["model"], e["difference_to_first"]) for e in results["models"][1:]]
         rows += table(
             ("model", "rooms x seeds", "seeds (t)"),
-            ((d["model"], _range(d), _range(d["seeds_t"])) for d in differences),
+            ((m, _range(d), _range(d["seeds_t"])) for m, d in differences),
         )
     rows += ["", "Accuracy by moved objects in view (mean over seeds, %):", ""]
     bins = list(results["models"][0]["summary"]["by_moved"]) if results["models"] else []
