@@ -341,7 +341,7 @@ def replace_block(text: str, name: str, body: str) -> str:
     """``text`` with the block ``name`` holding ``body``.
 
     Raises:
-        SystemExit: the document has no such block.
+        SystemExit: the document has no such block, or more than one.
     """
     begin, end = f"<!-- bench/navigation.py: {name} -->", f"<!-- end {name} -->"
     try:
