@@ -22,6 +22,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from sgdata.markdown import table
+
 CONFIG = """
 [dataset]
 name = "bench"
@@ -112,16 +114,11 @@ def main() -> None:
             rows.append(json.loads(out.stdout.strip().splitlines()[-1]))
             print(rows[-1], flush=True)
     print()
-    print(
-        "| rooms | workers | views | wall (s) | views/s | render views/s | main peak (MiB) "
-        "| worker peak (MiB) |"
-    )
-    print("|---|---|---|---|---|---|---|---|")
-    for r in rows:
-        print(
-            f"| {r['rooms']} | {r['workers']} | {r['views']} | {r['wall_s']} | {r['views_per_s']} "
-            f"| {r['render_views_per_s']} | {r['main_peak_mib']} | {r['worker_peak_mib']} |"
-        )
+    header = ("rooms", "workers", "views", "wall (s)", "views/s", "render views/s",
+              "main peak (MiB)", "worker peak (MiB)")  # fmt: skip
+    keys = ("rooms", "workers", "views", "wall_s", "views_per_s", "render_views_per_s",
+            "main_peak_mib", "worker_peak_mib")  # fmt: skip
+    print("\n".join(table(header, ([r[k] for k in keys] for r in rows))))
     for rooms in sorted({r["rooms"] for r in rows}):
         by_workers = {r["workers"]: r for r in rows if r["rooms"] == rooms}
         if 1 in by_workers and 2 in by_workers:

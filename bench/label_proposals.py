@@ -7,14 +7,15 @@ python bench/label_proposals.py --write    # replace it in docs/labeling.md
 from __future__ import annotations
 
 import argparse
-import re
 from pathlib import Path
 
 from seannet.provenance import ProcessState
+from sgdata.errors import SgdataError
 from sgdata.label.accuracy import score_proposals
 from sgdata.label.classes import load_class_names
 from sgdata.label.models import PhotoLabels
 from sgdata.label.proposals import DEFAULT_RULES
+from sgdata.markdown import replace_block
 
 ROOT = Path(__file__).resolve().parents[1]
 LABELS = ROOT / "tests/sgdata/label/data"
@@ -54,11 +55,10 @@ def main() -> None:
     if not args.write:
         print(text)
         return
-    doc = DOC.read_text(encoding="utf-8")
-    block = f"{BEGIN}\n{text}\n{END}"
-    doc, n = re.subn(re.escape(BEGIN) + r".*?" + re.escape(END), lambda _: block, doc, flags=re.S)
-    if n != 1:
-        raise SystemExit(f"{DOC}: expected one {BEGIN} ... {END} block")
+    try:
+        doc = replace_block(DOC.read_text(encoding="utf-8"), BEGIN, END, text)
+    except SgdataError as error:
+        raise SystemExit(f"{DOC}: {error}") from None
     DOC.write_text(doc, encoding="utf-8")
     print(f"wrote the table in {DOC} (at commit {ProcessState.capture(ROOT).commit[:7]})")
 

@@ -41,6 +41,7 @@ from torch.utils.data import DataLoader
 from seannet.data.datasets import ImageTransform, TripletDataset, collate_triplets
 from seannet.data.image_cache import open_image_cache
 from sgdata.dataset import Dataset, decode_image
+from sgdata.markdown import table
 
 
 def generate_tiny(root: Path) -> None:
@@ -223,9 +224,8 @@ def main() -> None:
             if len(times) > 1:
                 warm = n / (sum(times[1:]) / len(times[1:]))
                 rows.append((f"{label}, epochs 2-{len(times)}", warm, warm / bound))
-    print("\n| | triplets/s | / bound |\n|---|---|---|")
-    for label, rate, ratio in rows:
-        print(f"| {label} | {rate:,.1f} | {ratio:.2f} |")
+    cells = ((label, f"{rate:,.1f}", f"{ratio:.2f}") for label, rate, ratio in rows)
+    print("\n" + "\n".join(table(("", "triplets/s", "/ bound"), cells)))
 
     raw_s, gather_s, load_s = interleaved(
         root, args.split, args.size, args.batch_size, args.cache_dir or True, args.rounds

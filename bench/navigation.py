@@ -55,10 +55,12 @@ from seannet.navigation.stop_threshold import (
     choose_epsilon,
 )
 from seannet.navigation.tables import (
+    EPSILON_HEADER,
     INTERVAL,
     RATE_HEADER,
     SPLIT_HEADER,
     TIME_HEADER,
+    epsilon_rows,
     rate_rows,
     read_results,
     time_rows,
@@ -71,7 +73,9 @@ from seannet.provenance import (
 )
 from seannet.training.runs import BEST, HISTORY, load_checkpoint
 from seannet.weights import LITE0_WEIGHTS
+from sgdata import markdown
 from sgdata.dataset import Dataset
+from sgdata.errors import SgdataError
 from sgdata.fileio import atomic_write_text
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -302,11 +306,7 @@ def measured_block(out: Path, suffix: str = "") -> str:
             *table(SPLIT_HEADER, rate_rows(results, "replan", split=True)),
         ]
     lines += ["", "Time per episode:", "", *table(TIME_HEADER, time_rows(results))]
-    eps = [
-        [f"{r['model']} ({r['label']})", f"{r['epsilon']:.3f}", r["epsilon_source"]]
-        for r in results["runs"]
-    ]
-    lines += ["", *table(["localizer", "epsilon", "from"], eps)]
+    lines += ["", *table(EPSILON_HEADER, epsilon_rows(results))]
     return "\n".join(lines)
 
 
@@ -341,13 +341,13 @@ def replace_block(text: str, name: str, body: str) -> str:
     """``text`` with the block ``name`` holding ``body``.
 
     Raises:
-        SystemExit: the document has no such block.
+        SystemExit: the document has no such block, or more than one.
     """
     begin, end = f"<!-- bench/navigation.py: {name} -->", f"<!-- end {name} -->"
-    pattern = re.compile(re.escape(begin) + r".*?" + re.escape(end), re.S)
-    if not pattern.search(text):
-        raise SystemExit(f"no block {begin} ... {end} in the document")
-    return pattern.sub(lambda _: f"{begin}\n{body}\n{end}", text)
+    try:
+        return markdown.replace_block(text, begin, end, body)
+    except SgdataError as error:
+        raise SystemExit(str(error)) from None
 
 
 def write_tables(out: Path | None, doc: Path) -> None:

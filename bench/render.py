@@ -73,7 +73,7 @@ class NaivePyrender:
 
     def load(self, geometry: SceneGeometry, *, textured: bool = False) -> None:
         from sgdata.render.primitives import mesh_primitives, texture
-        from sgdata.render.renderer import _ceiling_light_pose
+        from sgdata.render.renderer import ceiling_light_pose
 
         pr, camera = self.pr, self.camera
 
@@ -95,9 +95,7 @@ class NaivePyrender:
         cam = pr.PerspectiveCamera(yfov=camera.yfov, aspectRatio=camera.width / camera.height)
         self.cam_node = scene.add(cam)
         scene.add(pr.DirectionalLight(color=np.ones(3), intensity=2.0), parent_node=self.cam_node)
-        scene.add(
-            pr.PointLight(color=np.ones(3), intensity=6.0), pose=_ceiling_light_pose(geometry)
-        )
+        scene.add(pr.PointLight(color=np.ones(3), intensity=6.0), pose=ceiling_light_pose(geometry))
         self.scene, self.seg = scene, seg
 
     def view(self, pose: ViewPose) -> tuple[np.ndarray, np.ndarray]:

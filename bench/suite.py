@@ -53,7 +53,9 @@ from pathlib import Path
 from typing import Any, NamedTuple
 
 from seannet.provenance import ProcessState
+from seannet.training.step_table import step_table
 from sgdata.fileio import atomic_write_text
+from sgdata.markdown import table
 
 BENCH = Path(__file__).resolve().parent
 ROOT = BENCH.parent
@@ -157,7 +159,7 @@ def _render_section(r: dict[str, Any]) -> list[str]:
         ),
         ("pipeline textured / flat", f"{r['textured/flat']:.2f}x", AIMS["textured/flat"]),
     ]
-    return _table(("measurement", "figure", "aim"), rows)
+    return table(("measurement", "figure", "aim"), rows)
 
 
 GENERATE_RUNS = (("local, 1 worker", 1, "local"), ("local, 2 workers", 2, "local"),
@@ -196,7 +198,7 @@ def _generate_section(runs: list[dict[str, Any]]) -> list[str]:
         return f"**{name}**", f"{best[over] / best[under]:.2f}x{spread}", AIMS[name]
 
     rows += [ratio("2 workers / 1", 1, 0), ratio("Ray local / local pool", 2, 1)]
-    return _table(("run (each round's wall time)", "fastest round", "aim"), rows)
+    return table(("run (each round's wall time)", "fastest round", "aim"), rows)
 
 
 def _loader_commands(args: argparse.Namespace, tiny: Path) -> list[list[str]]:
@@ -213,7 +215,7 @@ def _validate_commands(args: argparse.Namespace, tiny: Path) -> list[list[str]]:
 
 
 def _validate_section(r: dict[str, Any]) -> list[str]:
-    return _table(("dataset", "seconds"), [(f"`{r['dataset']}`", f"{r['seconds']:.1f}")])
+    return table(("dataset", "seconds"), [(f"`{r['dataset']}`", f"{r['seconds']:.1f}")])
 
 
 def _channels_commands(args: argparse.Namespace, tiny: Path) -> list[list[str]]:
@@ -231,7 +233,7 @@ def _channels_section(r: dict[str, Any]) -> list[str]:
     return [
         f"Room `{r['room']}`, {r['views']} views, each run twice (ABAB).",
         "",
-        *_table(("measurement", "figure", "aim"), rows),
+        *table(("measurement", "figure", "aim"), rows),
     ]
 
 
@@ -246,7 +248,7 @@ def _assets_section(r: dict[str, Any]) -> list[str]:
         for k, v in r.items()
         if k.startswith("ratio_")
     ]
-    return [*_table(("ratio", "figure"), ratios), "", *_table(("figure", "value"), rows)]
+    return [*table(("ratio", "figure"), ratios), "", *table(("figure", "value"), rows)]
 
 
 def _train_commands(args: argparse.Namespace, tiny: Path) -> list[list[str]]:
@@ -254,25 +256,13 @@ def _train_commands(args: argparse.Namespace, tiny: Path) -> list[list[str]]:
 
 
 def _train_section(r: dict[str, Any]) -> list[str]:
-    first = r["networks"][0]["network"]
-    rows = [
-        (
-            f"`{n['network']}`",
-            f"{n['step_s']:.3f}",
-            f"{n['step_ratio']:.2f}x",
-            f"{100 * n['spread']:.0f} %",
-            f"{100 * n['busy']:.0f} %",
-            str(n["batches"]),
-        )
-        for n in r["networks"]
-    ]
     return [
         f"A step of {r['batch_size']} triplets of the `cpu` preset, timed the way a run's "
         f"budget is ({r['clock']}; `seannet.training.budget.calibrate`): the networks "
         f"docs/results.md trains, and the batches per epoch {r['budget_s']:g} s buy each over "
         f"{r['epochs']} epochs. A budget buys batches in inverse proportion to these steps.",
         "",
-        *_table(("network", "step s", f"x {first}", "spread", "busy", "batches per epoch"), rows),
+        *step_table(r["networks"]),
     ]
 
 
@@ -291,7 +281,7 @@ def _fuzz_section(reports: list[dict[str, Any]]) -> list[str]:
         )
         for r in reports
     ]
-    return _table(("surface", "tried", "refused", "failures", "seconds"), rows)
+    return table(("surface", "tried", "refused", "failures", "seconds"), rows)
 
 
 def _tests_commands(args: argparse.Namespace, tiny: Path) -> list[list[str]]:
@@ -311,27 +301,19 @@ def _tests_section(runs: list[dict[str, Any]]) -> list[str]:
         )
         for r in runs
     ]
-    lines = _table(("command", "wall time", "tests", "sum of test times", "peak disk"), rows)
+    lines = table(("command", "wall time", "tests", "sum of test times", "peak disk"), rows)
     full = next((r for r in runs if r["target"] == "test"), None)
     if full:
         lines += [
             "",
             f"The slowest ten of `make {full['target']}` (set-up, call and teardown):",
             "",
-            *_table(
+            *table(
                 ("test", "seconds"),
                 [(f"`{c['test']}`", f"{c['seconds']:.1f}") for c in full["slowest"]],
             ),
         ]
     return lines
-
-
-def _table(header: tuple[str, ...], rows: list[tuple[str, ...]]) -> list[str]:
-    return [
-        "| " + " | ".join(header) + " |",
-        "|" + "---|" * len(header),
-        *("| " + " | ".join(row) + " |" for row in rows),
-    ]
 
 
 _LP1 = {"LP_NUM_THREADS": "1"}

@@ -13,6 +13,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+from seannet.markdown import table
+
 __all__ = [
     "IMAGE_SIZE",
     "IMAGENET_MEAN",
@@ -151,14 +153,13 @@ def normalisation(family: str) -> tuple[tuple[float, ...], tuple[float, ...]]:
 
 def network_table() -> str:
     """The registry as a markdown table (for the docs and ``seannet networks``)."""
-    rows = [
-        "| network | normalisation | features | C4 channels | input | offline ImageNet weights |",
-        "|---|---|---|---|---|---|",
-    ]
+    rows = []
     for r in NETWORKS.values():
         name = f"`{r.name}`" + (f" (`@{r.alias}`)" if r.alias else "")
         c4 = str(r.c4_channels) if r.c4_channels else "-"
         offline = f"`+imagenet` ({r.install.split(' (')[0]})" if r.offline else "-"
         norm = "ImageNet mean / std" if r.mean == IMAGENET_MEAN else "(x - 127) / 128"
-        rows.append(f"| {name} | {norm} | {r.feature_width} | {c4} | {r.resolution} | {offline} |")
-    return "\n".join(rows) + "\n"
+        rows.append((name, norm, r.feature_width, c4, r.resolution, offline))
+    header = ("network", "normalisation", "features", "C4 channels", "input",
+              "offline ImageNet weights")  # fmt: skip
+    return "\n".join(table(header, rows)) + "\n"

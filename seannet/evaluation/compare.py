@@ -57,6 +57,7 @@ from seannet.evaluation.intervals import (
     welch_difference,
 )
 from seannet.evaluation.run_eval import evaluate_run
+from seannet.markdown import table
 from seannet.model.specs import parse_spec
 from seannet.provenance import PROCESS, provenance_record
 from seannet.training.budget import Calibration, calibrate
@@ -421,23 +422,10 @@ def markdown(results: dict[str, Any]) -> str:
         f"# Comparison on test (preset {results['preset']}, budget {results['budget_s']} s "
         f"per run; lr of each model chosen on val from {results['lrs']})",
         "",
-        "| model | lr | val acc | seeds | test acc (seeds t) | rooms x seeds 95 % | recall@1 | "
-        "tier 0 | tier 1 | d' | triplets / rooms |",
-        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
-    for e in results["models"]:
-        s = e["summary"]
-        tiers = s["per_tier"]
-        two = s["two_level"]
-        val = e["val_accuracy_by_lr"][f"{e['lr']:g}"]
-        rows.append(
-            f"| {e['model']} | {e['lr']:g} | {100 * val:.1f} | "
-            f"{s['accuracy']['n']} | {_pm(s['accuracy'])} | "
-            f"[{100 * two['low']:.1f}, {100 * two['high']:.1f}] | {_pm(s['recall1'])} | "
-            f"{_pm(tiers['0']) if '0' in tiers else '-'} | "
-            f"{_pm(tiers['1']) if '1' in tiers else '-'} | "
-            f"{s['d_prime']['mean']:.2f} | {s['triplets']} / {s['rooms']} |"
-        )
+    header = ("model", "lr", "val acc", "seeds", "test acc (seeds t)", "rooms x seeds 95 %",
+              "recall@1", "tier 0", "tier 1", "d'", "triplets / rooms")  # fmt: skip
+    rows += table(header, (_model_cells(e) for e in results["models"]))
     if len(results["models"]) > 1:
         first = results["models"][0]["model"]
         rows += [
@@ -447,16 +435,35 @@ def markdown(results: dict[str, Any]) -> str:
             "over its seeds, t on the smaller seed count - 1 dof) and Welch's seed-level "
             "t-interval:",
             "",
-            "| model | rooms x seeds | seeds (t) |",
-            "|---|---|---|",
         ]
-        for e in results["models"][1:]:
-            d = e["difference_to_first"]
-            rows.append(f"| {e['model']} | {_range(d)} | {_range(d['seeds_t'])} |")
+        differences = [(e["model"], e["difference_to_first"]) for e in results["models"][1:]]
+        rows += table(
+            ("model", "rooms x seeds", "seeds (t)"),
+            ((m, _range(d), _range(d["seeds_t"])) for m, d in differences),
+        )
     rows += ["", "Accuracy by moved objects in view (mean over seeds, %):", ""]
     bins = list(results["models"][0]["summary"]["by_moved"]) if results["models"] else []
-    rows += ["| model | " + " | ".join(bins) + " |", "|---|" + "---|" * len(bins)]
-    for e in results["models"]:
-        moved = e["summary"]["by_moved"]
-        rows.append(f"| {e['model']} | " + " | ".join(_pm(moved[b]) for b in bins) + " |")
+    moved = [(e["model"], e["summary"]["by_moved"]) for e in results["models"]]
+    rows += table(("model", *bins), ((m, *(_pm(by[b]) for b in bins)) for m, by in moved))
     return "\n".join(rows) + "\n"
+
+
+def _model_cells(e: dict[str, Any]) -> tuple[str, ...]:
+    """One model's row of the comparison's first table."""
+    s = e["summary"]
+    tiers = s["per_tier"]
+    two = s["two_level"]
+    val = e["val_accuracy_by_lr"][f"{e['lr']:g}"]
+    return (
+        e["model"],
+        f"{e['lr']:g}",
+        f"{100 * val:.1f}",
+        f"{s['accuracy']['n']}",
+        _pm(s["accuracy"]),
+        f"[{100 * two['low']:.1f}, {100 * two['high']:.1f}]",
+        _pm(s["recall1"]),
+        _pm(tiers["0"]) if "0" in tiers else "-",
+        _pm(tiers["1"]) if "1" in tiers else "-",
+        f"{s['d_prime']['mean']:.2f}",
+        f"{s['triplets']} / {s['rooms']}",
+    )

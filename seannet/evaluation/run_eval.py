@@ -33,6 +33,7 @@ from seannet.evaluation.metrics import (
 )
 from seannet.evaluation.retrieval import accuracy_by_moved, map_recall, separation
 from seannet.evaluation.scene_term import BOX_KERNEL, SceneTerm
+from seannet.markdown import table
 from seannet.training.runs import MODEL_KEYS, restore_run
 from sgdata.dataset import Dataset
 from sgdata.errors import SgdataError
@@ -188,6 +189,10 @@ def _plain(grid: np.ndarray) -> list[list[float | None]]:
     return [[None if math.isnan(v) else round(float(v), 4) for v in row] for row in grid]
 
 
+def _percent_rows(shares: dict[str, float]) -> list[tuple[str, str]]:
+    return [(k, f"{100 * v:.1f} %") for k, v in shares.items()]
+
+
 def _markdown(result: dict) -> str:
     retrieval, nan = result["retrieval"], float("nan")
     lines = [
@@ -206,20 +211,17 @@ def _markdown(result: dict) -> str:
         f"{result['separation'].get('one_step_mean', nan):.3f}, "
         f"d' = {result['separation']['d_prime']:.2f}",
         "",
-        "| moved objects in view | triplets | accuracy |",
-        "|---|---|---|",
-        *(
-            f"| {k} | {v['triplets']} | {100 * v['accuracy']:.1f} % |"
-            for k, v in result["by_moved"].items()
+        *table(
+            ("moved objects in view", "triplets", "accuracy"),
+            (
+                (k, v["triplets"], f"{100 * v['accuracy']:.1f} %")
+                for k, v in result["by_moved"].items()
+            ),
         ),
         "",
-        "| tier | accuracy |",
-        "|---|---|",
-        *(f"| {k} | {100 * v:.1f} % |" for k, v in result["per_tier"].items()),
+        *table(("tier", "accuracy"), _percent_rows(result["per_tier"])),
         "",
-        "| room | accuracy |",
-        "|---|---|",
-        *(f"| {k} | {100 * v:.1f} % |" for k, v in result["per_room"].items()),
+        *table(("room", "accuracy"), _percent_rows(result["per_room"])),
     ]
     return "\n".join(lines) + "\n"
 

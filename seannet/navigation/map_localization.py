@@ -29,6 +29,7 @@ from seannet.data.live_views import layout_boxes
 from seannet.data.moved import BIN_NAMES, moved_bin, moved_instances
 from seannet.errors import DataError, MapError
 from seannet.evaluation.retrieval import recall_at_k
+from seannet.markdown import table
 from seannet.navigation.localizer import AnyLocalizer, open_localizer
 from seannet.navigation.maps import TopoMap, check_map, load_map, map_dirs
 from seannet.training.runs import MODEL_KEYS
@@ -252,15 +253,21 @@ def _queries_markdown(result: dict[str, Any]) -> str:
         f"# {result['model']} localization (epsilon {result['epsilon']:.3f}, "
         f"{result['epsilon_source']})",
         "",
-        "| query | rank | room | sub-node (i, j, h) | S | S > epsilon |",
-        "|---|---|---|---|---|---|",
     ]
-    for q in result["queries"]:
-        for rank, m in enumerate(q["matches"], 1):
-            lines.append(
-                f"| {q['query']} | {rank} | {m['room_id']} | {tuple(m['sub_node'])} | "
-                f"{m['similarity']:.4f} | {'yes' if m['passes_epsilon'] else 'no'} |"
-            )
+    matches = [
+        (
+            q["query"],
+            rank,
+            m["room_id"],
+            tuple(m["sub_node"]),
+            f"{m['similarity']:.4f}",
+            "yes" if m["passes_epsilon"] else "no",
+        )
+        for q in result["queries"]
+        for rank, m in enumerate(q["matches"], 1)
+    ]
+    header = ("query", "rank", "room", "sub-node (i, j, h)", "S", "S > epsilon")
+    lines += table(header, matches)
     return "\n".join(lines) + "\n"
 
 
@@ -274,14 +281,12 @@ def _retrieval_markdown(result: dict[str, Any]) -> str:
         "",
         f"epsilon {result['epsilon']:.3f} ({result['epsilon_source']})",
         "",
-        "| moved objects in view | queries | recall@1 | recall@5 | S(true) > epsilon |",
-        "|---|---|---|---|---|",
-        f"| all | {result['queries']} | {_pct(result['recall@1'])} | "
-        f"{_pct(result['recall@5'])} | {_pct(result['true_passes_epsilon'])} |",
     ]
-    for b, r in result["by_moved"].items():
-        lines.append(
-            f"| {b} | {r['queries']} | {_pct(r['recall@1'])} | {_pct(r['recall@5'])} | "
-            f"{_pct(r['true_passes_epsilon'])} |"
-        )
+    bins = [("all", result), *result["by_moved"].items()]
+    rows = [
+        (b, r["queries"], _pct(r["recall@1"]), _pct(r["recall@5"]), _pct(r["true_passes_epsilon"]))
+        for b, r in bins
+    ]
+    header = ("moved objects in view", "queries", "recall@1", "recall@5", "S(true) > epsilon")
+    lines += table(header, rows)
     return "\n".join(lines) + "\n"

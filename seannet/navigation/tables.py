@@ -26,10 +26,12 @@ from seannet.navigation.episodes import CASES, CAUSES, LOCALIZATION_KINDS, OUTCO
 from sgdata.fileio import atomic_write_text
 
 __all__ = [
+    "EPSILON_HEADER",
     "INTERVAL",
     "RULES",
     "Z95",
     "case_rates",
+    "epsilon_rows",
     "markdown",
     "rate_rows",
     "read_results",
@@ -137,6 +139,7 @@ RATE_HEADER = [
     *(f"{name} % N / A" for name in OUTCOMES),
 ]
 SPLIT_HEADER = ["localizer", *(f"{name} % N / A" for name in DETAILS)]
+EPSILON_HEADER = ["localizer", "epsilon", "from"]
 TIME_HEADER = ["localizer", "episodes", *(f"{p} s / episode" for p in TIME_PARTS), "steps"]
 
 
@@ -171,6 +174,11 @@ def time_rows(results: dict[str, Any]) -> list[list[str]]:
     return rows
 
 
+def epsilon_rows(results: dict[str, Any]) -> list[list[str]]:
+    """Each run's stop threshold and where it came from (:data:`EPSILON_HEADER`'s columns)."""
+    return [[_label(r), f"{r['epsilon']:.3f}", r["epsilon_source"]] for r in results["runs"]]
+
+
 def markdown(results: dict[str, Any]) -> str:
     """``navigate_<split>.md``: the paper-rule table, its failure split, the ``--replan``
     table when run, time per episode, each run's epsilon."""
@@ -191,12 +199,7 @@ def markdown(results: dict[str, Any]) -> str:
         lines += ["", f"## {titles[rule]}", "", *table(RATE_HEADER, rate_rows(results, rule))]
         lines += ["", *table(SPLIT_HEADER, rate_rows(results, rule, split=True))]
     lines += ["", "## Time per episode", "", *table(TIME_HEADER, time_rows(results))]
-    lines += [
-        "",
-        "| localizer | epsilon | from |",
-        "|---|---|---|",
-        *(f"| {_label(r)} | {r['epsilon']:.3f} | {r['epsilon_source']} |" for r in results["runs"]),
-    ]
+    lines += ["", *table(EPSILON_HEADER, epsilon_rows(results))]
     return "\n".join(lines) + "\n"
 
 

@@ -1,6 +1,7 @@
 """Stage 3, training: ``TrainConfig`` and its presets, the one training loop and the one
 evaluation loop, run directories (checkpoints, restoring a run), ``train``, and the budget
-(batches a budget of one thread's seconds buys, load-robust)."""
+(batches a budget of one thread's seconds buys, load-robust) with what a step costs: its table
+and its profile part by part."""
 
 from sgdata.lazy_face import lazy_face
 
@@ -19,6 +20,8 @@ _EXPORTS = {
     "build_for_dataset": ".runs",
     "device_for_run": ".runs",
     "restore_run": ".runs",
+    "profile_step": ".step_profile",
+    "step_table": ".step_table",
     "train": ".train",
 }
 

@@ -43,6 +43,7 @@ from sgdata.dataset.storage import (
     stored_image_field,
 )
 from sgdata.errors import DatasetError
+from sgdata.markdown import table
 
 __all__ = [
     "FORMAT_VERSION",
@@ -359,15 +360,15 @@ def primitive_name(t: pa.DataType) -> str:
     return next(name for name, p in _PRIMITIVES.items() if p == t)
 
 
-def _rows(fields: list[pa.Field], prefix: str) -> list[str]:
-    lines = []
+def _rows(fields: list[pa.Field], prefix: str) -> list[tuple[str, str, str, str]]:
+    lines: list[tuple[str, str, str, str]] = []
     for f in fields:
         doc = (f.metadata or {}).get(b"doc", b"").decode()
         if since(f):
             doc = f"{doc} (since format {since(f)})"
         doc = doc.replace("|", "\\|").replace("<", "\\<")  # Markdown table cell
         null = "yes" if f.nullable else "no"
-        lines.append(f"| `{prefix}{f.name}` | `{_type_text(f.type, f)}` | {null} | {doc} |")
+        lines.append((f"`{prefix}{f.name}`", f"`{_type_text(f.type, f)}`", null, doc))
         inner = f.type
         while pa.types.is_list(inner) or pa.types.is_fixed_size_list(inner):
             inner = inner.value_type
@@ -381,5 +382,5 @@ def _rows(fields: list[pa.Field], prefix: str) -> list[str]:
 
 def schema_markdown(schema: pa.Schema) -> str:
     """A Markdown table of ``schema``'s fields (nested ones as ``objects[].slot``), from docs."""
-    header = ["| column | type | nullable | meaning |", "|---|---|---|---|"]
-    return "\n".join(header + _rows(list(schema), "")) + "\n"
+    header = ("column", "type", "nullable", "meaning")
+    return "\n".join(table(header, _rows(list(schema), ""))) + "\n"

@@ -64,7 +64,7 @@ from sgdata.render.target import use_single_sample_target
 from sgdata.render.uniforms import cache_uniform_locations
 from sgdata.usd.meshes import Lighting, MeshData, SceneGeometry
 
-__all__ = ["RenderedView", "Renderer", "use_egl_platform"]
+__all__ = ["RenderedView", "Renderer", "ceiling_light_pose", "use_egl_platform"]
 
 _EGL_HINT = (
     "cannot start an EGL (headless OpenGL) context: {why}; install the Debian packages "
@@ -202,7 +202,7 @@ class Renderer:
         self._key = pr.DirectionalLight(color=np.ones(3), intensity=self.key_intensity)
         self._key_node = sc.add(self._key)
         self._fill = pr.PointLight(color=np.ones(3), intensity=self.fill_intensity)
-        sc.add(self._fill, pose=_ceiling_light_pose(scene))
+        sc.add(self._fill, pose=ceiling_light_pose(scene))
         self._set_lighting(scene.lighting)
         self._rc = None  # built on the first raycast id pass
 
@@ -459,8 +459,9 @@ class Renderer:
         return self._face_owner[prim].reshape(cam.height, cam.width)
 
 
-def _ceiling_light_pose(scene: SceneGeometry) -> np.ndarray:
-    """A pose 0.3 m under the centre of the structure's top (the ceiling)."""
+def ceiling_light_pose(scene: SceneGeometry) -> np.ndarray:
+    """A pose 0.3 m under the centre of the structure's top (the ceiling): where the renderer
+    hangs its fill light (and bench/render.py's plain pyrender its point light)."""
     pose = np.eye(4)
     if scene.structure:
         points = np.concatenate([m.vertices for m in scene.structure])

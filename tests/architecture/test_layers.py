@@ -1,6 +1,6 @@
 """The house's layering (docs/architecture.md): stages import downwards only, no cycles
-(imports inside functions and type-only imports count), seannet reaches only the sgdata it
-may, and the reading side loads no USD, renderer or torch."""
+(imports inside functions, type-only imports and run-time ones by literal count), seannet
+reaches only the sgdata it may, and the reading side loads no USD, renderer or torch."""
 
 from __future__ import annotations
 
@@ -48,11 +48,15 @@ LIVE_VIEWS_MAY_IMPORT = ("sgdata.render", "sgdata.usd", "sgdata.annotate", "sgda
 HEAVY = ("pxr", "pyrender", "open3d", "trimesh", "torch", "OpenGL", "sgdata.render", "sgdata.usd")
 
 
-def _imports(path: Path, package: str = "sgdata", *, dynamic: bool = False) -> set[str]:
+def _imports(
+    path: Path, package: str = "sgdata", *, dynamic: bool = False, module: str = ""
+) -> set[str]:
     """Every ``package`` module a file imports: at module level, inside functions and under
     ``if TYPE_CHECKING:`` (a circle of types is still a circle for a reader); with
     ``dynamic``, also the modules it imports at run time: a literal handed to
-    ``import_module``, and in a file that calls ``import_module`` itself, every import path
+    ``import_module`` or ``__import__``, the literal module name or ``.py`` path handed to
+    ``spec_from_file_location`` (a bare file name is a sibling of ``module``, the file's own
+    name), and in a file that calls ``import_module`` itself, every import path
     ``"pkg.module:name"`` it holds (a registry resolving its own table; a record that only
     names a builder another module resolves is data, not an import)."""
     found = set()
@@ -68,14 +72,36 @@ def _imports(path: Path, package: str = "sgdata", *, dynamic: bool = False) -> s
         elif resolves and isinstance(node, ast.Constant) and isinstance(node.value, str):
             if IMPORT_PATH.fullmatch(node.value):
                 found.add(node.value.partition(":")[0])
-        elif dynamic and isinstance(node, ast.Call) and _called(node) == "import_module":
+        elif dynamic and isinstance(node, ast.Call) and _called(node) in DYNAMIC_IMPORTS:
             first = node.args[0] if node.args else None
             if isinstance(first, ast.Constant) and isinstance(first.value, str):
                 found.add(first.value)
+        elif dynamic and isinstance(node, ast.Call) and _called(node) == "spec_from_file_location":
+            found |= _file_location_edges(node, module)
     return {m for m in found if m == package or m.startswith(package + ".")}
 
 
 IMPORT_PATH = re.compile(r"[a-z_][a-z0-9_]*(\.[a-z_][a-z0-9_]*)+(:[A-Za-z_]\w*)?")
+DYNAMIC_IMPORTS = ("import_module", "__import__")  # their first argument names the module
+
+
+def _file_location_edges(call: ast.Call, module: str) -> set[str]:
+    """The modules a ``spec_from_file_location`` call names by literals: its module name, and
+    each ``.py`` path among its arguments (``pkg/entry.py`` is ``pkg.entry``; a bare
+    ``entry.py``, as in ``Path(__file__).parent / "entry.py"``, a sibling of ``module``)."""
+    edges = set()
+    for node in ast.walk(call):
+        if not (isinstance(node, ast.Constant) and isinstance(node.value, str)):
+            continue
+        text = node.value
+        if text.endswith(".py"):
+            dotted = text.removesuffix(".py").removeprefix("./").replace("/", ".")
+            if "." not in dotted and module:
+                dotted = f"{module.rpartition('.')[0]}.{dotted}"
+            edges.add(dotted.removesuffix(".__init__"))
+        elif IMPORT_PATH.fullmatch(text) and node is (call.args[0] if call.args else None):
+            edges.add(text)
+    return edges
 
 
 def _called(node: ast.Call) -> str:
@@ -127,24 +153,57 @@ def test_no_import_cycle(package: str) -> None:
     _assert_no_cycle(_modules(package), package)
 
 
-def test_a_circle_closed_by_a_dynamic_import_is_found(tmp_path: Path) -> None:
-    """A registry that imports its entries by name, and an entry that imports the registry:
-    no ``import`` statement closes the circle, the check still sees it."""
-    (tmp_path / "registry.py").write_text(
+# a registry loading its entry at run time, each way a circle can close with no import line
+DYNAMIC_LOADS = {
+    "import_module": 'import importlib\ndef load():\n    importlib.import_module("pkg.entry")\n',
+    "__import__": 'def load():\n    __import__("pkg.entry")\n',
+    "resolved table": (
         'import importlib\nTABLE = {"a": "pkg.entry:Thing"}\n'
-        'def load():\n    importlib.import_module("pkg.entry")\n'
-    )
+        "def load(where):\n    importlib.import_module(where)\n"
+    ),
+    "spec_from_file_location, module name": (
+        "import importlib.util\ndef load(path):\n"
+        '    importlib.util.spec_from_file_location("pkg.entry", path)\n'
+    ),
+    "spec_from_file_location, path": (
+        "import importlib.util\ndef load():\n"
+        '    importlib.util.spec_from_file_location("entry", "pkg/entry.py")\n'
+    ),
+    "spec_from_file_location, sibling file": (
+        "import importlib.util\nfrom pathlib import Path\ndef load():\n"
+        '    importlib.util.spec_from_file_location("e", Path(__file__).parent / "entry.py")\n'
+    ),
+}
+
+
+@pytest.mark.parametrize("load", DYNAMIC_LOADS)
+def test_a_circle_closed_by_a_dynamic_import_is_found(tmp_path: Path, load: str) -> None:
+    """A registry that imports its entries by name or file, and an entry that imports the
+    registry: no ``import`` statement closes the circle, the check still sees it."""
+    (tmp_path / "registry.py").write_text(DYNAMIC_LOADS[load])
     (tmp_path / "entry.py").write_text("from pkg.registry import TABLE\n")
     modules = [("pkg.registry", tmp_path / "registry.py"), ("pkg.entry", tmp_path / "entry.py")]
     with pytest.raises(pytest.fail.Exception, match="pkg.entry -> pkg.registry"):
         _assert_no_cycle(modules, "pkg")
 
 
+def test_a_registry_loading_a_file_by_a_variable_path_closes_no_circle(tmp_path: Path) -> None:
+    """The registry's own ``file.py:factory`` loader names no module: no edge, no circle."""
+    (tmp_path / "registry.py").write_text(
+        "import importlib.util\ndef load(name, path):\n"
+        "    importlib.util.spec_from_file_location(name, path)\n"
+    )
+    (tmp_path / "entry.py").write_text("from pkg.registry import TABLE\n")
+    modules = [("pkg.registry", tmp_path / "registry.py"), ("pkg.entry", tmp_path / "entry.py")]
+    _assert_no_cycle(modules, "pkg")
+
+
 def _assert_no_cycle(modules: list[tuple[str, Path]], package: str) -> None:
     names = {m for m, _ in modules}
     graph: dict[str, set[str]] = {}
     for module, path in modules:
-        edges = {_owner(t, names) for t in _imports(path, package, dynamic=True)}
+        found = _imports(path, package, dynamic=True, module=module)
+        edges = {_owner(t, names) for t in found}
         graph[module] = edges - {module, None}
     state: dict[str, int] = {}
 

@@ -14,6 +14,8 @@ from types import ModuleType
 
 import pytest
 
+from seannet.training.step_profile import PARTS
+
 from ..bench_scripts import BENCH, load_bench
 
 
@@ -41,7 +43,7 @@ def test_profile_books_the_whole_step_to_parts(mini_dataset: Path, tmp_path: Pat
     rows = [line.split(" | ") for line in out.splitlines() if line.startswith("| ")]
     header, *parts, step = rows
     assert header[0] == "| part" and step[0] == "| **step**"
-    labels = [label for _, label in _bench().PARTS]
+    labels = [label for _, label in PARTS]
     assert len(parts) == len(labels)
     for row, label in zip(parts, labels, strict=True):
         assert row[0].startswith("| " + label.split("{")[0].split(" (")[0]), (row[0], label)
@@ -51,7 +53,7 @@ def test_profile_books_the_whole_step_to_parts(mini_dataset: Path, tmp_path: Pat
     assert all(abs(f + b - t) < 0.2 for f, b, t, *_ in list(cells.values())[:-1])
     assert abs(sum(values[3] for values in cells.values()) - 100) < 1.0
     assert sum(values[4] for values in cells.values()) == _number(step[-1].strip(" |"))
-    by_key = dict(zip((key for key, _ in _bench().PARTS), cells.values(), strict=True))
+    by_key = dict(zip((key for key, _ in PARTS), cells.values(), strict=True))
     for key in ("backbone", "head", "objects", "pathways", "fc", "optimiser"):
         assert by_key[key][2] > 0, key
     assert by_key["fc"][4] == 6144 * 4096 + 4096 + 4096 * 2048 + 2048  # the 6,144 -> ...
