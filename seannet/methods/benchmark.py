@@ -61,7 +61,7 @@ from seannet.methods.checks import (
     embed_views,
     guarded,
 )
-from seannet.methods.registry import load_method
+from seannet.methods.registry import load_method, method_source, method_title
 from seannet.methods.views import Budget, SplitData
 from seannet.seeds import DEFAULT_SEEDS
 from seannet.training.config import DEFAULT_PRESET
@@ -456,4 +456,5 @@ def benchmark_method(
     if navigation is not None:
         say(f"{name}: navigation test, seed {first['seed']}")
         summary["navigation"] = navigation(directory)
-    return write_card(directory, name, dataset, config, runs, summary, trained=trained)
+    return write_card(directory, name, dataset, config, runs, summary, trained=trained,
+                      title=method_title(name, method), source=method_source(name))  # fmt: skip

@@ -103,6 +103,20 @@ def _breaks(summary: dict[str, Any], measure: str) -> str:
     return f"never ({held[-1][0]}: {pct(held[-1][1]['accuracy'])} %)" if held else "never"
 
 
+def _spec_line(card: dict[str, Any]) -> list[str]:
+    """What ``seannet benchmark --methods`` took, when the card's title differs from it, with
+    a plug-in file's sha256 (the code that made the card)."""
+    spec = card.get("spec", card["method"])
+    if spec == card["method"]:
+        return []
+    where, _, attr = spec.rpartition(":")
+    if where.endswith(".py"):
+        spec = f"{Path(where).name}:{attr}"  # the file, not the folders of the machine
+    source = card["provenance"].get("method_source")
+    code = f", sha256 `{source['sha256'][:16]}…`" if source else ""
+    return [f"Loaded from `{spec}`{code}.", ""]
+
+
 def _markdown(card: dict[str, Any]) -> str:
     s = card["summary"]
     kind = f"trained, {s['seeds']} seeds" if card["trained"] else "no training"
@@ -111,6 +125,7 @@ def _markdown(card: dict[str, Any]) -> str:
         "",
         cards_stamp([card]),
         "",
+        *_spec_line(card),
         f"- {kind}; test read once; every choice on val (epsilon {s['epsilon']:.3f})",
         f"- triplet accuracy: **{_interval(s['accuracy_rooms_seeds'])} %** (rooms x seeds, "
         f"95 %) over {s['triplets']} test triplets",
@@ -254,14 +269,23 @@ def write_card(
     summary: dict[str, Any],
     *,
     trained: bool,
+    title: str | None = None,
+    source: dict[str, str] | None = None,
 ) -> Path:
     """Write ``card.json``, ``card.md`` and ``sweep.png`` (each atomically); the JSON path.
-    ``data`` (opened, or its root) is stamped in the card's provenance."""
+    ``data`` (opened, or its root) is stamped in the card's provenance. The card calls the
+    method ``title`` (default ``name``) and keeps ``name`` as its ``spec``, what
+    ``seannet benchmark --methods`` takes; ``source`` (a plug-in's file and sha256,
+    :func:`~seannet.methods.registry.method_source`) goes into the provenance."""
+    provenance = provenance_record(data, step="benchmark")
+    if source is not None:
+        provenance["method_source"] = source
     card = {
         "card": 1,
-        "method": name,
+        "method": title or name,
+        "spec": name,
         "trained": trained,
-        "provenance": provenance_record(data, step="benchmark"),
+        "provenance": provenance,
         "config": {k: v for k, v in asdict(config).items() if k != "noise"}
         | {"noise": [n.label() for n in config.noise]},
         "summary": summary,
@@ -301,9 +325,10 @@ def leaderboard_rows(cards: list[dict[str, Any]], *, timing: bool = True) -> lis
     header = ["method", "seeds", "accuracy % (rooms x seeds, 95 %)", "recall@1 %", "recall@5 %",
               "breaks at (moved objects)", *(["ms / view"] if timing else []), "bytes / entry",
               "navigation success % N / A"]  # fmt: skip
+    titles = [c["method"] for c in cards]
     rows = [
         [
-            f"`{c['method']}`",
+            _board_name(c, titles.count(c["method"]) > 1),
             str(c["summary"]["seeds"]) if c["trained"] else "- (no training)",
             _interval(c["summary"]["accuracy_rooms_seeds"]),
             _interval(c["summary"]["recall1"]),
@@ -316,6 +341,13 @@ def leaderboard_rows(cards: list[dict[str, Any]], *, timing: bool = True) -> lis
         for c in sorted(cards, key=lambda c: -c["summary"]["accuracy"]["mean"])
     ]
     return table(header, rows)
+
+
+def _board_name(card: dict[str, Any], shared: bool) -> str:
+    """A card's method as the leaderboard says it; a title two cards share (two plug-ins'
+    classes of one name) gets the label of the spec that made it."""
+    name = f"`{card['method']}`"
+    return f"{name} ({method_label(card['spec'])})" if shared and "spec" in card else name
 
 
 def leaderboard(cards: list[dict[str, Any]]) -> str:

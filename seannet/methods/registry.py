@@ -4,6 +4,7 @@ import path ``package.module:factory`` (or ``path/file.py:factory``) and the ent
 
 from __future__ import annotations
 
+import hashlib
 import importlib
 import importlib.util
 import sys
@@ -21,6 +22,8 @@ __all__ = [
     "Method",
     "load_method",
     "method_names",
+    "method_source",
+    "method_title",
     "register_method",
 ]
 
@@ -151,3 +154,29 @@ def load_method(name: str) -> tuple[Callable[[], Any], bool]:
     from seannet.methods.bundled import NetworkMethod
 
     return (lambda: NetworkMethod(name)), True
+
+
+def method_title(name: str, method: Any) -> str:
+    """How a card and the leaderboard call method ``name``: one loaded by import path by its
+    ``name`` attribute, else its class (not the path the user typed, which names a machine's
+    folders); any other method by ``name``."""
+    if ":" not in name:
+        return name
+    given = getattr(method, "name", None)
+    return given if isinstance(given, str) and given else type(method).__name__
+
+
+def method_source(name: str) -> dict[str, str] | None:
+    """The file a method loaded by import path came from and its sha256 (which code made a
+    card), or None for a registered, entry-point or bundled method (the commit names those)."""
+    where, colon, _ = name.rpartition(":")
+    if not colon:
+        return None
+    if where.endswith(".py"):
+        path = Path(where)
+    else:
+        spec = importlib.util.find_spec(where)
+        if spec is None or spec.origin is None:
+            return None
+        path = Path(spec.origin)
+    return {"file": path.name, "sha256": hashlib.sha256(path.read_bytes()).hexdigest()}

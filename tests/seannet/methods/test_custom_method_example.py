@@ -4,6 +4,7 @@ A bad method is one line on stderr and a non-zero exit."""
 
 from __future__ import annotations
 
+import hashlib
 import json
 import subprocess
 import sys
@@ -33,11 +34,19 @@ def test_the_example_is_a_short_file_one_command_from_a_card(
     card = json.loads(
         (tmp_path / "cards" / "custom_method.py__ColourBoxes" / "card.json").read_text()
     )
-    assert card["method"] == method and not card["trained"]
+    # named by its class, not the folders of this machine; the file's bytes in provenance
+    assert card["method"] == "ColourBoxes" and card["spec"] == method and not card["trained"]
+    source = card["provenance"]["method_source"]
+    assert source == {"file": "custom_method.py",
+                      "sha256": hashlib.sha256(EXAMPLE.read_bytes()).hexdigest()}  # fmt: skip
     assert card["summary"]["box_noise"]  # it uses boxes: the noise sweep ran
     assert card["provenance"]["command"].endswith(f"--methods {method} --out cards")
+    markdown = (tmp_path / "cards" / "custom_method.py__ColourBoxes" / "card.md").read_text()
+    assert "# Benchmark card: ColourBoxes" in markdown
+    assert f"Loaded from `custom_method.py:ColourBoxes`, sha256 `{source['sha256'][:16]}" in markdown
     board = _run("leaderboard", "cards", cwd=tmp_path)
-    assert board.returncode == 0 and "custom_method.py:ColourBoxes" in board.stdout
+    assert board.returncode == 0 and "`ColourBoxes`" in board.stdout
+    assert str(EXAMPLE.parent) not in board.stdout
 
 
 def test_a_bad_method_is_one_line_on_stderr(tmp_path: Path, mini_dataset: Path) -> None:

@@ -198,6 +198,29 @@ def test_reference_methods_get_cards_and_a_leaderboard(tmp_path: Path, mini_data
     assert "`tiny-image`" in table and "`boxes-overlap`" in table
 
 
+def test_a_plugin_is_named_by_its_class_and_its_file_is_hashed(tmp_path: Path) -> None:
+    import hashlib
+
+    from seannet.methods.cards import _board_name
+    from seannet.methods.registry import method_source, method_title
+
+    user = tmp_path / "deep" / "folders" / "mine.py"
+    user.parent.mkdir(parents=True)
+    user.write_text("class Mine:\n    pass\n\nclass Named:\n    name = 'my-net'\n")
+    assert method_title(f"{user}:Mine", load_method(f"{user}:Mine")[0]()) == "Mine"
+    assert method_title(f"{user}:Named", load_method(f"{user}:Named")[0]()) == "my-net"
+    assert method_title("tiny-image", object()) == "tiny-image"  # a registered name stays
+    digest = hashlib.sha256(user.read_bytes()).hexdigest()
+    assert method_source(f"{user}:Mine") == {"file": "mine.py", "sha256": digest}
+    module = method_source("seannet.methods.reference:TinyImage")
+    assert module is not None and module["file"] == "reference.py"
+    assert method_source("tiny-image") is None and method_source("resnet18+boxes") is None
+    # two plug-ins' classes of one name stay apart on the leaderboard
+    card = {"method": "Mine", "spec": f"{user}:Mine"}
+    assert _board_name(card, shared=False) == "`Mine`"
+    assert _board_name(card, shared=True) == "`Mine` (mine.py__Mine)"
+
+
 def test_the_leaderboard_says_where_a_method_breaks_or_how_far_the_change_reached() -> None:
     from seannet.methods.benchmark import breaking_point
     from seannet.methods.cards import _breaks
