@@ -43,7 +43,8 @@ def test_the_example_is_a_short_file_one_command_from_a_card(
     assert card["provenance"]["command"].endswith(f"--methods {method} --out cards")
     markdown = (tmp_path / "cards" / "custom_method.py__ColourBoxes" / "card.md").read_text()
     assert "# Benchmark card: ColourBoxes" in markdown
-    assert f"Loaded from `custom_method.py:ColourBoxes`, sha256 `{source['sha256'][:16]}" in markdown
+    loaded = f"Loaded from `custom_method.py:ColourBoxes`, sha256 `{source['sha256'][:16]}"
+    assert loaded in markdown
     board = _run("leaderboard", "cards", cwd=tmp_path)
     assert board.returncode == 0 and "`ColourBoxes`" in board.stdout
     assert str(EXAMPLE.parent) not in board.stdout
