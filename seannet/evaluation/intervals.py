@@ -141,11 +141,14 @@ def two_level_interval(
 
     Returns:
         ``mean``, ``low``, ``high``, ``half`` (the half-width), the two standard errors
-        ``room_se`` and ``seed_se``, and ``seeds``.
+        ``room_se`` and ``seed_se``, and ``seeds``. The bounds stay within [0, 1] (an accuracy
+    cannot pass them; two seeds' t quantile can: 80.4 % ± 27 points read [53.0, 107.7]);
+    ``half`` keeps the width the variance gives.
     """
     mean = float((matrix.mean(axis=0) * weight).sum() / weight.sum())
     room_var = _room_variance([matrix], weight, resamples)
-    return _components(mean, room_var, _seed_variance(matrix, weight), matrix.shape[0])
+    got = _components(mean, room_var, _seed_variance(matrix, weight), matrix.shape[0])
+    return got | {"low": max(0.0, got["low"]), "high": min(1.0, got["high"])}
 
 
 def two_level_difference(

@@ -93,3 +93,12 @@ def test_seed_level_intervals() -> None:
     assert w["high"] - w["mean"] == pytest.approx(2.776 * 0.02 * (2 / 3) ** 0.5, abs=1e-3)
     one = welch_difference([0.8], [0.7])
     assert one["mean"] == pytest.approx(0.1) and np.isnan(one["low"])
+
+
+def test_an_accuracy_interval_stays_within_0_and_1() -> None:
+    # two seeds far apart near the top: the t quantile on 1 dof reaches past 100 %
+    wide = two_level_interval(_runs([0.15, 0.19]), WEIGHT)
+    assert wide["mean"] - wide["half"] > 0.0 and wide["mean"] + wide["half"] > 1.0
+    assert wide["high"] == 1.0 and wide["low"] == pytest.approx(wide["mean"] - wide["half"])
+    low = two_level_interval(_runs([-0.79, -0.75]), WEIGHT)
+    assert low["low"] == 0.0
