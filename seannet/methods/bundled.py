@@ -12,7 +12,6 @@ import torch
 import torch.nn.functional as F
 from torch import Tensor
 
-from seannet.evaluation.box_kernel import BoxKernel
 from seannet.evaluation.compare import model_spec
 from seannet.evaluation.scene_term import SceneTerm
 from seannet.methods.boxes import box_scores, box_vectors, row_triplets, vector_boxes
@@ -119,24 +118,6 @@ class NetworkMethod:
         self.scene.choose_weight(
             s_ap, s_an, *self.scene.triplet_scores(boxes, row_triplets(val.triplets))
         )
-
-    @property
-    def box_weight(self) -> float:
-        """lambda, chosen on val (0 before :meth:`fit`)."""
-        return self.scene.weight
-
-    @property
-    def kernel(self) -> BoxKernel | None:
-        """``+box-kernel``'s kernel, fit on train (None before :meth:`fit` or for ``+boxes``)."""
-        return self.scene.kernel
-
-    def __setstate__(self, state: dict[str, object]) -> None:
-        # a method.pt pickled before the SceneTerm held box_weight and kernel itself
-        if "scene" not in state:
-            scene = SceneTerm(state["parsed"].scene, state.pop("kernel", None))  # type: ignore[attr-defined]
-            scene.weight = float(state.pop("box_weight", 0.0))  # type: ignore[arg-type]
-            state["scene"] = scene
-        self.__dict__.update(state)
 
     @torch.no_grad()
     def embed(self, views: Views) -> Tensor:
