@@ -16,7 +16,7 @@ from seannet.evaluation.compare import model_spec
 from seannet.evaluation.scene_term import SceneTerm
 from seannet.methods.boxes import box_scores, box_vectors, row_triplets, vector_boxes
 from seannet.methods.views import Budget, SplitData, Views
-from seannet.model.specs import SEANNET, parse_spec
+from seannet.model.specs import ResolvedSpec
 from seannet.training.config import DEFAULT_PRESET
 from seannet.training.config import preset as load_preset
 from seannet.training.runs import LAST, restore_run
@@ -51,12 +51,15 @@ class NetworkMethod:
 
     trainable = True
 
-    def __init__(self, spec: str, *, preset: str = DEFAULT_PRESET) -> None:
-        self.parsed = parse_spec(spec)
-        self.name = spec
-        self.uses_boxes = bool(self.parsed.scene) or (
-            self.parsed.name.startswith(SEANNET) and self.parsed.name != "seannet-image"
-        )
+    def __init__(self, spec: ResolvedSpec, *, preset: str = DEFAULT_PRESET) -> None:
+        if not isinstance(spec, ResolvedSpec):  # parsed once, where the name came in
+            raise TypeError(
+                f"NetworkMethod takes a ResolvedSpec (seannet.model.specs.parse_spec), got "
+                f"{type(spec).__name__}"
+            )
+        self.parsed = spec
+        self.name = spec.spec
+        self.uses_boxes = spec.uses_boxes
         self._configure(preset)
         self.model: torch.nn.Module | None = None
         self.device = torch.device("cpu")
@@ -65,7 +68,7 @@ class NetworkMethod:
         self._dim = 0
 
     def _configure(self, preset: str, **changes: object) -> None:
-        self.config = model_spec(self.name, load_preset(preset).replace(**changes)).config
+        self.config = model_spec(self.parsed, load_preset(preset).replace(**changes)).config
         self.image_size = self.config.model.image_size
         self.network = self.config.model.image_family
 
@@ -77,7 +80,7 @@ class NetworkMethod:
         if budget.batches:
             changes["max_train_batches"] = budget.batches
         self._configure(budget.preset, **changes)
-        spec = model_spec(self.name, self.config)
+        spec = model_spec(self.parsed, self.config)
         work = budget.work or Path(tempfile.mkdtemp(prefix="seannet-method-"))
         self.scene = SceneTerm.from_spec(self.parsed.scene)  # the lr is chosen on S alone
         by_lr: dict[str, float] = {}

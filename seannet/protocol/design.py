@@ -184,8 +184,6 @@ class Plan:
 def network_of(method: str) -> str | None:
     """The bundled network a model spec trains (``resnet18+boxes`` -> ``resnet18``), or None
     for a method that is not a model spec."""
-    from seannet.model.specs import parse_spec
-
     if ":" in method:
         return None
     from seannet.methods.registry import load_method
@@ -194,7 +192,7 @@ def network_of(method: str) -> str | None:
         _, bundled = load_method(method)
     except Exception:  # noqa: BLE001 - not loadable now: the unit says why when it runs
         return None
-    return parse_spec(method).trained if bundled else None
+    return bundled.trained if bundled is not None else None
 
 
 def chosen_lrs(

@@ -158,6 +158,7 @@ def test_a_benchmarked_network_opens_by_its_card_directory_in_a_fresh_interprete
     mini_dataset: Path, tmp_path: Path
 ) -> None:
     from seannet.methods.bundled import NetworkMethod
+    from seannet.model.specs import parse_spec
     from seannet.training.runs import restore_run
 
     config = BenchmarkConfig(seeds=(0,), batch_size=16, batches=1, epochs=1, noise=())
@@ -165,7 +166,7 @@ def test_a_benchmarked_network_opens_by_its_card_directory_in_a_fresh_interprete
     directory = card_file.parent
     choices = json.loads(card_file.read_text())["runs"][0]["choices"]
     # the reference: the network the fit kept, read back from its run's checkpoint
-    reference = NetworkMethod("resnet18+boxes")
+    reference = NetworkMethod(parse_spec("resnet18+boxes"))
     reference.model = restore_run(Path(choices["run"]), mini_dataset).model
     expected = _embed(MethodLocalizer("resnet18+boxes", reference), mini_dataset)
     fresh = _fresh_embed(directory, mini_dataset, tmp_path)
