@@ -40,7 +40,8 @@ def train(
     model: Annotated[
         str | None,
         typer.Option(
-            help=f"One of {', '.join(MODEL_NAMES)} (default: the preset's: "
+            help=f"A model spec NAME[@net][+imagenet], NAME one of {', '.join(MODEL_NAMES)} "
+            "(default: the preset's: "
             + ", ".join(f"{v.model.name} in {k}" for k, v in PRESETS.items())
             + ")."
         ),
@@ -66,12 +67,20 @@ def train(
     """Train a model with the triplet loss; validates every epoch, keeps the best checkpoint."""
     from rich.progress import Progress
 
+    from seannet.evaluation.compare import model_spec
     from seannet.training.config import preset as load_preset
     from seannet.training.train import train as run_training
 
     config = load_preset(preset).replace(seed=seed)
     if model:
-        config = config.replace(model=model)
+        spec = model_spec(model, config)  # the one parse of the spec
+        if spec.boxes:
+            raise typer.BadParameter(
+                f"--model {model}: train trains {spec.trained}; its scene term {spec.boxes} is "
+                "fit by `seannet eval --boxes` or `seannet benchmark`"
+            )
+        config = spec.config
+        pretrained = pretrained if pretrained is not None else spec.pretrained
     if backbone:
         config = config.replace(backbone=backbone)
     if epochs:

@@ -30,7 +30,8 @@ __all__ = [
     "box_noise_seed",
 ]
 
-# The training seeds of a row when none are named (benchmark, compare): three, DESIGN §12's least
+# The training seeds of a row when none are named (benchmark, the protocol's rows): three,
+# DESIGN §12's least
 DEFAULT_SEEDS = (0, 1, 2)
 _INIT = 1 << 20  # the initial weights (epochs use 0, 1, 2, ...)
 _NAVIGATOR = "navigator"  # the purpose key of the visual navigator's streams

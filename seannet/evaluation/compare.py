@@ -58,7 +58,7 @@ from seannet.evaluation.intervals import (
 )
 from seannet.evaluation.run_eval import evaluate_run
 from seannet.markdown import table
-from seannet.model.specs import parse_spec
+from seannet.model.specs import ResolvedSpec, parse_spec
 from seannet.provenance import PROCESS, provenance_record
 from seannet.training.budget import Calibration, calibrate
 from seannet.training.config import DEFAULT_PRESET, TrainConfig
@@ -95,15 +95,16 @@ class ModelSpec:
     boxes: str  # the scene term added to the similarity (specs.SCENE_TERMS), or ""
 
 
-def model_spec(spec: str, base: TrainConfig) -> ModelSpec:
-    """What a spec ``NAME[@net][+imagenet][+boxes|+box-kernel]`` names, parsed against the
-    registry of networks (:func:`seannet.model.specs.parse_spec`) and set on ``base``.
+def model_spec(spec: str | ResolvedSpec, base: TrainConfig) -> ModelSpec:
+    """What a spec ``NAME[@net][+imagenet][+boxes|+box-kernel]`` names, set on ``base``: a
+    resolved spec as it is, a spec's text resolved here, where it comes in
+    (:func:`seannet.model.specs.parse_spec`).
 
     Raises:
         ModelError: an unknown name or network, or ``+imagenet`` asking for weights the spec's
             image network has none of offline; the message lists the choices.
     """
-    parsed = parse_spec(spec)
+    parsed = spec if isinstance(spec, ResolvedSpec) else parse_spec(spec)
     config = base.replace(**parsed.model_fields())
     pretrained = Path(parsed.pretrained) if parsed.pretrained else None
     return ModelSpec(parsed.spec, parsed.trained, config, pretrained, parsed.scene)

@@ -12,12 +12,11 @@ import torch
 import torch.nn.functional as F
 from torch import Tensor
 
-from seannet.evaluation.box_kernel import BoxKernel
 from seannet.evaluation.compare import model_spec
 from seannet.evaluation.scene_term import SceneTerm
 from seannet.methods.boxes import box_scores, box_vectors, row_triplets, vector_boxes
 from seannet.methods.views import Budget, SplitData, Views
-from seannet.model.specs import SEANNET, parse_spec
+from seannet.model.specs import ResolvedSpec
 from seannet.training.config import DEFAULT_PRESET
 from seannet.training.config import preset as load_preset
 from seannet.training.runs import LAST, restore_run
@@ -52,12 +51,15 @@ class NetworkMethod:
 
     trainable = True
 
-    def __init__(self, spec: str, *, preset: str = DEFAULT_PRESET) -> None:
-        self.parsed = parse_spec(spec)
-        self.name = spec
-        self.uses_boxes = bool(self.parsed.scene) or (
-            self.parsed.name.startswith(SEANNET) and self.parsed.name != "seannet-image"
-        )
+    def __init__(self, spec: ResolvedSpec, *, preset: str = DEFAULT_PRESET) -> None:
+        if not isinstance(spec, ResolvedSpec):  # parsed once, where the name came in
+            raise TypeError(
+                f"NetworkMethod takes a ResolvedSpec (seannet.model.specs.parse_spec), got "
+                f"{type(spec).__name__}"
+            )
+        self.parsed = spec
+        self.name = spec.spec
+        self.uses_boxes = spec.uses_boxes
         self._configure(preset)
         self.model: torch.nn.Module | None = None
         self.device = torch.device("cpu")
@@ -66,7 +68,7 @@ class NetworkMethod:
         self._dim = 0
 
     def _configure(self, preset: str, **changes: object) -> None:
-        self.config = model_spec(self.name, load_preset(preset).replace(**changes)).config
+        self.config = model_spec(self.parsed, load_preset(preset).replace(**changes)).config
         self.image_size = self.config.model.image_size
         self.network = self.config.model.image_family
 
@@ -78,7 +80,7 @@ class NetworkMethod:
         if budget.batches:
             changes["max_train_batches"] = budget.batches
         self._configure(budget.preset, **changes)
-        spec = model_spec(self.name, self.config)
+        spec = model_spec(self.parsed, self.config)
         work = budget.work or Path(tempfile.mkdtemp(prefix="seannet-method-"))
         self.scene = SceneTerm.from_spec(self.parsed.scene)  # the lr is chosen on S alone
         by_lr: dict[str, float] = {}
@@ -119,24 +121,6 @@ class NetworkMethod:
         self.scene.choose_weight(
             s_ap, s_an, *self.scene.triplet_scores(boxes, row_triplets(val.triplets))
         )
-
-    @property
-    def box_weight(self) -> float:
-        """lambda, chosen on val (0 before :meth:`fit`)."""
-        return self.scene.weight
-
-    @property
-    def kernel(self) -> BoxKernel | None:
-        """``+box-kernel``'s kernel, fit on train (None before :meth:`fit` or for ``+boxes``)."""
-        return self.scene.kernel
-
-    def __setstate__(self, state: dict[str, object]) -> None:
-        # a method.pt pickled before the SceneTerm held box_weight and kernel itself
-        if "scene" not in state:
-            scene = SceneTerm(state["parsed"].scene, state.pop("kernel", None))  # type: ignore[attr-defined]
-            scene.weight = float(state.pop("box_weight", 0.0))  # type: ignore[arg-type]
-            state["scene"] = scene
-        self.__dict__.update(state)
 
     @torch.no_grad()
     def embed(self, views: Views) -> Tensor:

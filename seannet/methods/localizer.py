@@ -26,8 +26,6 @@ import hashlib
 import io
 import json
 import math
-import pickle
-import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -63,8 +61,7 @@ __all__ = [
 BATCH = 16  # views per embed() call
 METHOD_FILE = "method.json"  # name, epsilon and its source, dataset identity, trained
 STATE_FILE = "method.pt"  # a fitted method's state: {"format": STATE_FORMAT, "state": ...}
-# 2: the method's state_dict(), tensors and plain data; 1 (no "format" key, read until the
-# next release): the whole method object pickled by torch.save
+# 2: the method's state_dict(), tensors and plain data (1, the pickled method, never released)
 STATE_FORMAT = 2
 _PLAIN = (str, int, float, bool, type(None))  # what a state holds besides tensors
 
@@ -319,8 +316,6 @@ def _restore(name: str, factory: Any, blob: bytes, path: Path) -> Any:
     """
     try:
         saved = torch.load(io.BytesIO(blob), map_location="cpu", weights_only=True)
-    except pickle.UnpicklingError:  # no plain-data file: format 1, the pickled method itself
-        return _legacy(name, blob, path)
     except Exception as exc:  # noqa: BLE001 - torch raises many types for a damaged file
         raise MethodError(
             f"{path}: unreadable method state ({type(exc).__name__}); benchmark it again"
@@ -338,23 +333,3 @@ def _restore(name: str, factory: Any, blob: bytes, path: Path) -> Any:
         )
     guarded(name, "load_state_dict", load, saved["state"])
     return method
-
-
-def _legacy(name: str, blob: bytes, path: Path) -> Any:
-    """A ``method.pt`` of format 1 (the whole method, pickled), read until the next release."""
-    method = guarded(name, "loading its state", _unpickle, blob)
-    if isinstance(method, dict) and "format" in method:  # format 2 that weights_only refused
-        raise MethodError(
-            f"{path}: a state of method {name!r} holding more than plain data; benchmark it again"
-        )
-    warnings.warn(
-        f"{path}: a pickled method (format 1), read until the next release; run seannet "
-        f"benchmark again to write its state_dict (format {STATE_FORMAT})",
-        DeprecationWarning,
-        stacklevel=4,
-    )
-    return method
-
-
-def _unpickle(blob: bytes) -> Any:
-    return torch.load(io.BytesIO(blob), map_location="cpu", weights_only=False)

@@ -20,7 +20,6 @@ import torch
 import torch.nn.functional as F
 from torch import Tensor, nn
 
-from seannet.evaluation.box_kernel import BoxKernel
 from seannet.evaluation.scene_term import BOX_KERNEL, SceneTerm
 from seannet.methods.boxes import box_scores, box_vectors, row_triplets, vector_boxes
 from seannet.methods.views import Budget, SplitData, Views
@@ -207,18 +206,6 @@ class BoxOverlap:
 
     def __init__(self) -> None:
         self.scene = SceneTerm.from_spec(self.term)
-
-    @property
-    def kernel(self) -> BoxKernel | None:
-        """The slot kernel (``boxes-kernel``, after ``fit``), else None."""
-        return self.scene.kernel
-
-    def __setstate__(self, state: dict[str, object]) -> None:
-        # a method.pt pickled before the SceneTerm held the kernel itself
-        if "scene" not in state:
-            kernel = state.pop("kernel", None)
-            state["scene"] = SceneTerm(self.term, kernel)  # type: ignore[arg-type]
-        self.__dict__.update(state)
 
     def embed(self, views: Views) -> Tensor:
         return box_vectors(views.slot_boxes())

@@ -11,11 +11,14 @@ import sys
 from collections.abc import Callable
 from importlib.metadata import entry_points
 from pathlib import Path
-from typing import Any, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 from torch import Tensor
 
 from seannet.errors import MethodError, ModelError
+
+if TYPE_CHECKING:
+    from seannet.model.specs import ResolvedSpec
 
 __all__ = [
     "ENTRY_POINT_GROUP",
@@ -118,8 +121,9 @@ def _from_path(target: str) -> Callable[[], Any]:
     return factory
 
 
-def load_method(name: str) -> tuple[Callable[[], Any], bool]:
-    """The factory of method ``name`` and whether it is a bundled network (a model spec).
+def load_method(name: str) -> tuple[Callable[[], Any], ResolvedSpec | None]:
+    """The factory of method ``name`` and, for a bundled network, its spec resolved (the one
+    parse of it: the factory builds the network from it); None for any other method.
 
     ``name`` is, in this order: an import path (``pkg.mod:make`` or ``file.py:make``), a name
     registered with :func:`register_method` (the reference methods included), an entry point
@@ -130,14 +134,14 @@ def load_method(name: str) -> tuple[Callable[[], Any], bool]:
     """
     try:
         if ":" in name:
-            return _from_path(name), False
+            return _from_path(name), None
         if name in REFERENCE:
-            return _from_path(REFERENCE[name]), False
+            return _from_path(REFERENCE[name]), None
         if name in _REGISTERED:
-            return _REGISTERED[name], False
+            return _REGISTERED[name], None
         found = _entry_points()
         if name in found:
-            return found[name].load(), False
+            return found[name].load(), None
     except MethodError:
         raise
     except Exception as exc:  # noqa: BLE001 - a user's module that fails to import
@@ -145,7 +149,7 @@ def load_method(name: str) -> tuple[Callable[[], Any], bool]:
     from seannet.model.specs import parse_spec
 
     try:
-        parse_spec(name)
+        spec = parse_spec(name)
     except ModelError:
         raise MethodError(
             f"method {name!r}: not registered, no entry point, no import path (pkg.mod:make) and "
@@ -153,7 +157,7 @@ def load_method(name: str) -> tuple[Callable[[], Any], bool]:
         ) from None
     from seannet.methods.bundled import NetworkMethod
 
-    return (lambda: NetworkMethod(name)), True
+    return (lambda: NetworkMethod(spec)), spec
 
 
 def method_title(name: str, method: Any) -> str:

@@ -14,6 +14,7 @@ import importlib.resources
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from torch import Tensor, nn
 from torchvision import models
@@ -234,19 +235,16 @@ def image_encoder(
     builder = _builder(record)
     if pretrained is not None:
         pretrained = Path(pretrained)
-    if name == "googlenet":
+    options: dict[str, Any] = {"weights": None}
+    if record.aux_heads:  # built as its weights file was saved, when there is one
         with_file = pretrained is not None
-        net = builder(
-            weights=None, aux_logits=with_file, transform_input=with_file, init_weights=True
-        )
-    else:
-        net = builder(weights=None)
+        options.update(aux_logits=with_file, transform_input=with_file, init_weights=True)
+    net = builder(**options)
     if pretrained is not None:
         load_pretrained(net, pretrained, arch=name, sha256=sha256)
-    if name == "googlenet":
+    if record.aux_heads:
         net.aux_logits, net.aux1, net.aux2 = False, None, None
-    if name == "vgg16":
-        net.classifier = net.classifier[:-1]  # keep fc6-ReLU-Dropout-fc7-ReLU-Dropout
-    else:
-        net.fc = nn.Identity()
+    head = getattr(net, record.classifier)
+    cut = record.classifier_cut
+    setattr(net, record.classifier, head[:-cut] if cut else nn.Identity())
     return net, width

@@ -9,11 +9,10 @@ from typing import Any
 import torch
 
 from seannet.errors import ModelError
-from seannet.model.backbones import ENCODER_NAMES
 from seannet.model.baselines import ImageEncoder
 from seannet.model.config import ModelConfig
 from seannet.model.seannet import SeanNet
-from seannet.model.specs import ABLATIONS, MODEL_NAMES, SEANNET
+from seannet.model.specs import ABLATIONS, MODEL_NAMES, MODELS
 from seannet.model.wordvectors import WordVectorTable
 from sgdata.annotate.slots import NUM_SLOTS
 
@@ -58,16 +57,16 @@ def build_model(
     """
     config = ModelConfig(name=model) if isinstance(model, str) else model
     config = config.replace(**overrides) if overrides else config
-    name = config.name
-    if name in ENCODER_NAMES:
+    entry = MODELS.get(config.name)
+    if entry is None:
+        raise ModelError(f"model {config.name!r}; expected one of {', '.join(MODEL_NAMES)}")
+    if not entry.seannet:
         return ImageEncoder(
-            name,
+            entry.name,
             embed_dim=config.embed_dim,
             pretrained=pretrained,
             pretrained_sha256=pretrained_sha256,
         )
-    if name != SEANNET and name not in ABLATIONS:
-        raise ModelError(f"model {name!r}; expected one of {', '.join(MODEL_NAMES)}")
     if word_vectors is None:
         from seannet.model.wordvectors import load_table
 
@@ -99,6 +98,6 @@ def build_model(
             "layout_grid": config.layout_grid,
             "layout_sketch": config.layout_sketch,
             "graph_hidden_dim": config.graph_hidden,
-            **ABLATIONS.get(name, {}),
+            **entry.kwargs,
         },
     )

@@ -1,5 +1,6 @@
-"""Model specs, ``NAME[@net][+imagenet][+boxes|+box-kernel]``: the names they may use and the
-one parser every command reads them with.
+"""Model specs, ``NAME[@net][+imagenet][+boxes|+box-kernel]``: the bundled models they may
+name (:data:`MODELS`, one entry each) and the one parser that resolves a spec, once, at the
+edge (:func:`parse_spec` -> :class:`ResolvedSpec`); every layer below takes the resolved spec.
 
 Plain data, no torch: the CLI prints its help from here, so naming a model loads nothing. The
 image networks come from the registry (:data:`seannet.weights.NETWORKS`); the SeanNet
@@ -8,7 +9,7 @@ ablations and the scene terms are listed here, once.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 from seannet.errors import ModelError
@@ -18,10 +19,12 @@ __all__ = [
     "ABLATIONS",
     "ABLATION_FIELDS",
     "IMAGENET",
+    "MODELS",
     "MODEL_NAMES",
     "SCENE_TERMS",
     "SEANNET",
-    "ModelSpecText",
+    "ModelEntry",
+    "ResolvedSpec",
     "parse_spec",
     "scene_term",
     "spec_help",
@@ -44,7 +47,43 @@ ABLATION_FIELDS: dict[str, dict[str, Any]] = {
     # a 512-wide GCN fc instead of the paper's 4,096: a CPU step near ResNet-18's
     "seannet-fc512": {"graph_hidden": 512},
 }
-MODEL_NAMES = (SEANNET, *ABLATIONS, *IMAGE_ENCODERS)
+
+
+@dataclass(frozen=True)
+class ModelEntry:
+    """One bundled model: what every layer below a spec asks of its name (the model's
+    builder, the benchmark's box sweep) is a field here, not a branch on the name."""
+
+    name: str  # "seannet", an ablation, or an image encoder of the registry
+    seannet: bool  # SeanNet or an ablation of it (else a whole image encoder)
+    # SeanNet's constructor arguments the ablation changes (:data:`ABLATIONS`)
+    kwargs: dict[str, Any] = field(default_factory=dict)
+    # ModelConfig fields the ablation sets (:data:`ABLATION_FIELDS`): its config holds them
+    fields: dict[str, Any] = field(default_factory=dict)
+    # its vectors read the visible objects' boxes (the box-noise sweep applies): SeanNet's
+    # graph branch and layout pathway do; the image branch alone and the encoders do not
+    uses_boxes: bool = False
+
+
+# every bundled model by name: SeanNet, its ablations, the registry's image encoders
+MODELS: dict[str, ModelEntry] = {
+    e.name: e
+    for e in (
+        ModelEntry(SEANNET, seannet=True, uses_boxes=True),
+        *(
+            ModelEntry(
+                name,
+                seannet=True,
+                kwargs=kwargs,
+                fields=ABLATION_FIELDS.get(name, {}),
+                uses_boxes=kwargs.get("branches") != "image",
+            )
+            for name, kwargs in ABLATIONS.items()
+        ),
+        *(ModelEntry(name, seannet=False) for name in IMAGE_ENCODERS),
+    )
+}
+MODEL_NAMES = tuple(MODELS)
 IMAGENET = "+imagenet"
 # what a model spec may add to its image similarity, ``S + lambda * S_scene``, lambda on val
 SCENE_TERMS = {
@@ -54,16 +93,28 @@ SCENE_TERMS = {
 
 
 @dataclass(frozen=True)
-class ModelSpecText:
-    """What a spec names, parsed (no training config yet: see ``compare.model_spec``)."""
+class ResolvedSpec:
+    """A spec resolved against the registries, once (:func:`parse_spec`): the model's entry,
+    its image network, its weights, its scene term. No training config yet:
+    ``compare.model_spec`` sets it on one."""
 
     spec: str  # as given, e.g. "seannet@lite0+imagenet+boxes"
-    name: str  # the model: "seannet", an ablation, or an image encoder of the registry
+    entry: ModelEntry  # the model: "seannet", an ablation, or an image encoder of the registry
     # the image network (a registry name): the encoder, SeanNet's ``@net``, or "" (SeanNet on
     # its config's backbone)
     network: str
     imagenet: bool  # start from the network's ImageNet weights that install offline
     scene: str  # the scene term of :data:`SCENE_TERMS` added to the similarity, or ""
+
+    @property
+    def name(self) -> str:
+        """The model's name (its entry's)."""
+        return self.entry.name
+
+    @property
+    def uses_boxes(self) -> bool:
+        """Whether the method's vectors read the boxes: the model's, or a scene term's."""
+        return self.entry.uses_boxes or bool(self.scene)
 
     @property
     def trained(self) -> str:
@@ -79,7 +130,7 @@ class ModelSpecText:
     def model_fields(self) -> dict[str, Any]:
         """The :class:`~seannet.model.config.ModelConfig` fields the spec sets."""
         fields: dict[str, Any] = {"name": self.name}
-        if self.name.startswith(SEANNET) and self.network:
+        if self.entry.seannet and self.network:
             record = NETWORKS[self.network]
             fields["backbone"] = record.family
             if record.depth:
@@ -100,8 +151,9 @@ def _offline_networks() -> list[str]:
     return [r.name for r in NETWORKS.values() if r.offline]
 
 
-def parse_spec(spec: str) -> ModelSpecText:
-    """Parse ``NAME[@net][+imagenet][+boxes|+box-kernel]`` against the registry.
+def parse_spec(spec: str) -> ResolvedSpec:
+    """Resolve ``NAME[@net][+imagenet][+boxes|+box-kernel]`` against the registries: the one
+    parse of a spec, where a command or a file hands it in.
 
     ``NAME`` is ``seannet``, an ablation of :data:`ABLATIONS` or an image encoder of the
     registry; ``@net`` puts a SeanNet model on another image network with a C4 map (a registry
@@ -117,9 +169,10 @@ def parse_spec(spec: str) -> ModelSpecText:
     trained = text.removesuffix(scene)
     imagenet = trained.endswith(IMAGENET)
     name, at, net = trained.removesuffix(IMAGENET).partition("@")
-    if name not in MODEL_NAMES:
+    entry = MODELS.get(name)
+    if entry is None:
         raise ModelError(f"model {spec!r}: unknown name {name!r}; {spec_help()}")
-    seannet = name.startswith(SEANNET)
+    seannet = entry.seannet
     if at:
         if not seannet:
             raise ModelError(f"model {spec!r}: '@' follows a seannet model, not {name!r}")
@@ -138,7 +191,7 @@ def parse_spec(spec: str) -> ModelSpecText:
             f"model {spec!r}: +imagenet needs a network whose ImageNet weights install offline "
             f"({offline}, or seannet@<one of them>); {network_name or SEANNET} has none"
         )
-    return ModelSpecText(text, name, network_name, imagenet, scene)
+    return ResolvedSpec(text, entry, network_name, imagenet, scene)
 
 
 def spec_help() -> str:

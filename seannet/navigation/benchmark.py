@@ -27,7 +27,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import time
-import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -88,7 +87,6 @@ def run_navigation(
     maps: Path | None = None,
     strips: Path | None = None,
     progress: Callable[[str], None] | None = None,
-    **settings: Any,
 ) -> dict[str, Any]:
     """Run the navigation test of every localizer run on the rooms of ``config.split``.
 
@@ -101,7 +99,6 @@ def run_navigation(
         workers: processes running maps and episodes in parallel.
         epsilon: one threshold for every run, or per run ``(epsilon, where it comes from)``
             (a run left out reads its eval files); None: each run's eval files.
-        settings: deprecated: the config's fields as keywords (``split=``, ``episodes=``...).
 
     Writes ``navigate_<split>.json`` and ``.md`` into ``out`` (default: the navigator run),
     maps under ``maps`` (default: ``out/maps``), and under ``strips`` when given, per run,
@@ -114,7 +111,7 @@ def run_navigation(
         NavigationError: bad counts, no epsilon for a run, a split without rooms, a room
             without an episode, or no ``out`` for the oracle.
     """
-    config = _config(config, settings)
+    config = config if config is not None else NavigationTestConfig()
     if workers < 1:
         raise NavigationError(f"--workers {workers}: expected >= 1")
     out = out if out is not None else navigator
@@ -169,23 +166,6 @@ def run_navigation(
 def results_path(out: Path, split: str) -> Path:
     """Where :func:`run_navigation` writes its results JSON for ``split`` (markdown beside)."""
     return out / f"navigate_{split}.json"
-
-
-def _config(config: NavigationTestConfig | None, settings: dict[str, Any]) -> NavigationTestConfig:
-    """``config`` with the deprecated keyword settings of before 2026-12-02 applied."""
-    config = config if config is not None else NavigationTestConfig()
-    if not settings:
-        return config
-    unknown = sorted(set(settings) - {f.name for f in dataclasses.fields(config)})
-    if unknown:
-        raise TypeError(f"run_navigation() got unexpected keyword arguments {unknown}")
-    warnings.warn(
-        f"run_navigation({', '.join(f'{k}=' for k in settings)}...) is deprecated: pass "
-        "NavigationTestConfig(...) as config",
-        DeprecationWarning,
-        stacklevel=3,
-    )
-    return config.replace(**settings)
 
 
 def _build_maps(

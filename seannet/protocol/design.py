@@ -27,6 +27,7 @@ from typing import Any
 
 from seannet.data.box_noise import BoxNoise
 from seannet.errors import ModelError
+from seannet.seeds import DEFAULT_SEEDS
 from seannet.training.config import DEFAULT_PRESET
 
 __all__ = [
@@ -75,7 +76,7 @@ class Row:
     """A method some doc shows, and what it needs measured."""
 
     method: str  # a model spec (``resnet18+boxes``), a registered method or an import path
-    seeds: int = 3
+    seeds: int = len(DEFAULT_SEEDS)  # seeds 0 .. seeds - 1
     noise: bool = False  # the box-noise grid on one seed, the aim's point on every seed
     full_map: bool = False  # recall among every sub-node of a test room's map, one seed
     stage: int = 0  # run order: every unit of stage 0 before any of stage 1 (the headline first)
@@ -112,7 +113,7 @@ class Design:
     def row(self, method: str) -> Row:
         return next(r for r in self.rows if r.method == method)
 
-    def with_methods(self, methods: list[str], seeds: int = 3) -> Design:
+    def with_methods(self, methods: list[str], seeds: int = len(DEFAULT_SEEDS)) -> Design:
         """This design with ``methods`` added as rows (a user's methods under our tables)."""
         have = {r.method for r in self.rows}
         added = tuple(Row(m, seeds=seeds) for m in methods if m not in have)
@@ -183,8 +184,6 @@ class Plan:
 def network_of(method: str) -> str | None:
     """The bundled network a model spec trains (``resnet18+boxes`` -> ``resnet18``), or None
     for a method that is not a model spec."""
-    from seannet.model.specs import parse_spec
-
     if ":" in method:
         return None
     from seannet.methods.registry import load_method
@@ -193,7 +192,7 @@ def network_of(method: str) -> str | None:
         _, bundled = load_method(method)
     except Exception:  # noqa: BLE001 - not loadable now: the unit says why when it runs
         return None
-    return parse_spec(method).trained if bundled else None
+    return bundled.trained if bundled is not None else None
 
 
 def chosen_lrs(
@@ -316,7 +315,7 @@ def _curve_rows(design: Design, rows: list[Row]) -> list[Row]:
 # The covisibility oracle (seannet.evaluation.covisibility_oracle): how many test triplets
 # the views can decide at all; a diagnostic unit, no method
 COVISIBILITY = "covisibility-oracle"
-SEANNET = "seannet-fc512"  # SeanNet as the cpu preset trains it (the paper's fc: `seannet`)
+SEANNET = "seannet-fc512"  # SeanNet as the default preset trains it (the paper's fc: `seannet`)
 # The headline: SeanNet, the strongest simple baseline (resnet18+boxes) and every baseline the
 # leaderboard holds; SeanNet and the strongest baseline on 5 seeds, the rest on 3.
 HEADLINE = (

@@ -44,12 +44,14 @@ from seannet.protocol.reading import (
     table,
     verdict,
 )
+from seannet.training.config import PRESETS
 from sgdata.fileio import atomic_write_bytes, atomic_write_text, save_png
 
 __all__ = ["Records", "leaderboard_doc", "results_doc", "write_docs"]
 
 CONTACT_SHEET = "images/covisibility-disagreements.png"  # under the docs folder
 AIM = 0.9  # the learning aim: triplet accuracy on test, and full-map recall@1
+PAPER = PRESETS["paper"].model  # the paper's network, named where no run measured it
 
 
 # ------------------------------------------------------------------------------ results.md
@@ -356,8 +358,8 @@ def results_doc(r: Records) -> str:
         "Results: SeanNet against the strongest simple baselines",
         f"Every row is measured against the first, `{r.first}`"
         + (
-            ": SeanNet as the `cpu` preset trains it (the paper's GCN fc, 4,096 wide, is "
-            "`seannet`: its section below)."
+            f": SeanNet as the `{design.preset}` preset trains it (the paper's GCN fc, 4,096 "
+            "wide, is `seannet`: its section below)."
             if r.first == SEANNET
             else "."
         ),
@@ -448,7 +450,7 @@ def results_doc(r: Records) -> str:
         "## Not measured by this protocol",
         "",
         "- Navigation with each network as localizer (docs/navigation.md has its own runs).",
-        "- The `paper` preset on a GPU (ResNet-50 at 224 px).",
+        f"- The `paper` preset on a GPU (ResNet-{PAPER.depth} at {PAPER.image_size} px).",
         "",
     ]
     return "\n".join(out)

@@ -91,15 +91,18 @@ _SHORT_SCHEDULE: dict[str, Any] = {
     "decay_every": 2,
 }
 
+# The preset a command trains with when none is named: this project's machines have no GPU
+DEFAULT_PRESET = "cpu"
+
 PRESETS: dict[str, TrainConfig] = {
     # The paper: ResNet-50 at 224 px, 60 epochs, SGD 0.01 x0.7 every 10 epochs, margin 0.1.
     "paper": TrainConfig(),  # every default: ModelConfig's and the fields above
-    # Two CPU cores in about half an hour for SeanNet: the short schedule at 112 px (C4 7 x 7,
-    # RoIAlign 7), 24 batches an epoch. Its model is seannet-fc512 (the GCN's fc 512 wide, not
-    # the paper's 4,096): a step near ResNet-18's (docs/benchmarks.md, "A training step"), as
-    # accurate under wave 3's protocol (docs/training.md, presets). Loader workers would only
-    # compete with torch for the two cores.
-    "cpu": TrainConfig().replace(
+    # The default: two CPU cores in about half an hour for SeanNet, the short schedule at
+    # 112 px (C4 7 x 7, RoIAlign 7), 24 batches an epoch. Its model is seannet-fc512 (the
+    # GCN's fc 512 wide, not the paper's 4,096): a step near ResNet-18's (docs/benchmarks.md,
+    # "A training step"), as accurate under wave 3's protocol (docs/training.md, presets).
+    # Loader workers would only compete with torch for the two cores.
+    DEFAULT_PRESET: TrainConfig().replace(
         model="seannet-fc512",
         **_SHORT_SCHEDULE,
         image_size=112,
@@ -118,10 +121,6 @@ PRESETS: dict[str, TrainConfig] = {
         num_workers=12,
     ),
 }
-
-
-# The preset a command trains with when none is named: this project's machines have no GPU
-DEFAULT_PRESET = "cpu"
 
 
 def preset(name: str) -> TrainConfig:

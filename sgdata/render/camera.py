@@ -9,7 +9,11 @@ import numpy as np
 
 from sgdata.errors import RenderError
 
-__all__ = ["CameraConfig"]
+__all__ = ["VIEW_SIZE", "CameraConfig"]
+
+# Pixels a side of a rendered view: the image networks' input (seannet.weights.IMAGE_SIZE,
+# which may not be imported down here; tests/seannet/test_weights.py holds the two equal)
+VIEW_SIZE = 224
 
 
 @dataclass(frozen=True)
@@ -20,8 +24,8 @@ class CameraConfig:
     [u, u + 1) x [v, v + 1) and its centre is (u + 0.5, v + 0.5).
     """
 
-    width: int = 224  # pixels (SeanNet input size)
-    height: int = 224  # pixels
+    width: int = VIEW_SIZE  # pixels
+    height: int = VIEW_SIZE  # pixels
     hfov_deg: float = 90.0  # horizontal field of view; AI2-THOR's default is 90
     eye_height: float = 1.5  # camera height above the floor (m), about AI2-THOR's agent eye
     # Positive looks down. 20 deg keeps the far wall's paintings and windows in view while

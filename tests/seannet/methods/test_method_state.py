@@ -1,6 +1,7 @@
 """A trained method's directory (``method.json`` + ``method.pt``) holds its ``state_dict``, not a
 pickle: a fresh interpreter rebuilds the method with its factory and gets the same vectors; a
-trained method without a state is one line at save time; the pickled format still opens."""
+trained method without a state is one line at save time; a pickled method is refused in one
+line."""
 
 from __future__ import annotations
 
@@ -157,6 +158,7 @@ def test_a_benchmarked_network_opens_by_its_card_directory_in_a_fresh_interprete
     mini_dataset: Path, tmp_path: Path
 ) -> None:
     from seannet.methods.bundled import NetworkMethod
+    from seannet.model.specs import parse_spec
     from seannet.training.runs import restore_run
 
     config = BenchmarkConfig(seeds=(0,), batch_size=16, batches=1, epochs=1, noise=())
@@ -164,13 +166,13 @@ def test_a_benchmarked_network_opens_by_its_card_directory_in_a_fresh_interprete
     directory = card_file.parent
     choices = json.loads(card_file.read_text())["runs"][0]["choices"]
     # the reference: the network the fit kept, read back from its run's checkpoint
-    reference = NetworkMethod("resnet18+boxes")
+    reference = NetworkMethod(parse_spec("resnet18+boxes"))
     reference.model = restore_run(Path(choices["run"]), mini_dataset).model
     expected = _embed(MethodLocalizer("resnet18+boxes", reference), mini_dataset)
     fresh = _fresh_embed(directory, mini_dataset, tmp_path)
     np.testing.assert_allclose(fresh["vectors"], expected, rtol=0, atol=1e-5)
     opened = open_method(directory, mini_dataset)
-    assert opened.method.box_weight == choices["box_weight"]["lambda"]  # lambda from val
+    assert opened.method.scene.weight == choices["box_weight"]["lambda"]  # lambda from val
     assert opened.method.choices == choices
     np.testing.assert_allclose(
         fresh["scores"], opened.score(fresh["vectors"], fresh["vectors"][::-1].copy()), atol=1e-6
@@ -224,27 +226,18 @@ def test_a_state_of_more_than_plain_data_is_refused_naming_where(
     assert not (tmp_path / STATE_FILE).exists() and not (tmp_path / METHOD_FILE).exists()
 
 
-def test_a_pickled_method_of_before_opens_with_a_deprecation_warning(
+def test_a_pickled_method_or_a_damaged_state_is_refused_in_one_line(
     mini_dataset: Path, tmp_path: Path
 ) -> None:
-    from seannet.evaluation.box_kernel import BoxKernel
-    from seannet.evaluation.scene_term import SceneTerm
     from seannet.methods.reference import BoxKernelMethod
 
-    kernel = BoxKernel(open_dataset(mini_dataset).manifest.num_slots)
-    with torch.no_grad():
-        kernel.slot_weight.uniform_(-1.0, 1.0)
-    method = BoxKernelMethod()
-    method.scene = SceneTerm("+box-kernel", kernel)
-    torch.save(method, tmp_path / STATE_FILE)  # format 1: the object itself
+    torch.save(BoxKernelMethod(), tmp_path / STATE_FILE)  # the object itself, not its state
     record = {"method": 1, "name": "boxes-kernel", "trained": True, "epsilon": 0.4,
               "epsilon_source": "val", "dataset": dataset_identity(mini_dataset)}  # fmt: skip
     (tmp_path / METHOD_FILE).write_text(json.dumps(record))
-    with pytest.warns(DeprecationWarning, match="pickled method .format 1"):
-        opened = open_method(tmp_path, mini_dataset)
-    assert torch.equal(opened.method.kernel.slot_weight, kernel.slot_weight)
-    # a damaged state is one line, not a traceback
-    (tmp_path / STATE_FILE).write_bytes(b"not a state")
-    with pytest.raises(MethodError, match="boxes-kernel") as error:
-        open_method(tmp_path, mini_dataset)
-    assert "\n" not in str(error.value)
+    for damaged in (None, b"not a state"):
+        if damaged is not None:
+            (tmp_path / STATE_FILE).write_bytes(damaged)
+        with pytest.raises(MethodError, match="benchmark it again") as error:
+            open_method(tmp_path, mini_dataset)
+        assert "\n" not in str(error.value)

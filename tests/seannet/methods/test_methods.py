@@ -72,8 +72,8 @@ def test_a_method_registers_three_ways(tmp_path: Path, monkeypatch: pytest.Monke
     (info / "entry_points.txt").write_text("[seannet.methods]\nplugged = plugin_methods:Plugin\n")
     monkeypatch.syspath_prepend(str(tmp_path))
     assert load_method("plugged")[0].__name__ == "Plugin"
-    # a model spec is a bundled network
-    assert load_method("resnet18+boxes")[1]
+    # a model spec is a bundled network, resolved there (its factory builds from that)
+    assert load_method("resnet18+boxes")[1].trained == "resnet18"
     with pytest.raises(MethodError, match="no model spec; registered: .*tiny-image"):
         load_method("nothing-of-that-name")
 

@@ -109,7 +109,7 @@ def test_graph_hidden_sets_the_fc_width_and_a_train_config_carries_it() -> None:
     first, last = model.gcn.fc[0], model.gcn.fc[2]
     assert (first.out_features, last.in_features, last.out_features) == (32, 32, 64)
     assert model.embed(_view_with_one_edge(0)).shape[0] == 1
-    config = preset("cpu").replace(model="seannet", graph_hidden=1024)
+    config = TrainConfig().replace(model="seannet", graph_hidden=1024)
     assert TrainConfig.from_dict(config.to_dict()).model.graph_hidden == 1024
     # the paper's 4,096 by default; the cpu preset's seannet-fc512 stores its own 512
     assert preset("paper").model.graph_hidden == 4096

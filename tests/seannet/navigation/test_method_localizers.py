@@ -132,6 +132,6 @@ def test_benchmark_with_a_navigator_puts_the_rates_in_the_card(
     opened = open_localizer(directory, mini_dataset)
     assert isinstance(opened, MethodLocalizer) and opened.name == "boxes-kernel"
     assert opened.epsilon == pytest.approx(nav["epsilon"])
-    assert opened.method.kernel is not None  # the kernel fit on train, not a fresh method
+    assert opened.method.scene.kernel is not None  # the kernel fit on train, not a fresh method
     board = leaderboard(read_cards([tmp_path / "cards"]))
     assert "navigation success % N / A" in board

@@ -6,10 +6,11 @@ import pytest
 
 from seannet.errors import ModelError
 from seannet.model.factory import build_model
-from seannet.training.config import PRESETS, preset
+from seannet.training.config import DEFAULT_PRESET, PRESETS, preset
 
 
 def test_the_cpu_preset_trains_the_512_wide_gcn_fc() -> None:
+    assert DEFAULT_PRESET == "cpu"  # what a command trains with when no preset is named
     cpu = preset("cpu")
     assert cpu.model.name == "seannet-fc512"
     model = build_model(cpu.model.replace(embed_dim=64), num_slots=16)
