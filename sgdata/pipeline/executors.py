@@ -80,9 +80,8 @@ def run_tasks(
     if executor == "ray":
         run_on_ray = _ray_executor().run_on_ray
 
-        yield from run_on_ray(
-            fn, jobs, workers=workers, address=address, retries=retries, env=WORKER_ENV
-        )
+        yield from run_on_ray(fn, jobs, workers=workers, address=address, retries=retries,
+                              env=WORKER_ENV, name=task_name)  # fmt: skip
         return
     yield from _run_local(fn, jobs, workers=workers)
 

@@ -18,7 +18,6 @@ import ray
 from ray.exceptions import RayActorError, RayTaskError, WorkerCrashedError
 
 from sgdata.errors import SgdataError, WorkerError
-from sgdata.pipeline.executors import task_name
 from sgdata.pipeline.reaper import start_reaper
 
 __all__ = ["run_on_ray", "ray_session"]
@@ -40,20 +39,23 @@ def run_on_ray(
     address: str | None,
     retries: int,
     env: dict[str, str],
+    name: Callable[[tuple, int], str],
 ) -> Iterator[dict]:
     """Run ``fn(*job)`` for every job on ``workers`` actors; yield results as they finish.
 
     A task whose worker died is tried again on a fresh worker, at most ``retries`` more times,
-    then reported by name (its room id). A task that raises an ``SgdataError`` (bad input, a
+    then reported by ``name(job, index)`` (its room id; the caller's, so this module never
+    imports the executors that import it). A task that raises an ``SgdataError`` (bad input, a
     file that cannot be written) is not retried: its message is re-raised as it is.
     """
     with ray_session(address, workers, env):
-        yield from _run(fn, jobs, workers=workers, retries=retries)
+        yield from _run(fn, jobs, workers=workers, retries=retries, name=name)
 
 
 def _run(
-    fn: Callable[..., dict], jobs: list[tuple], *, workers: int, retries: int
-) -> Iterator[dict]:
+    fn: Callable[..., dict], jobs: list[tuple], *, workers: int, retries: int,
+    name: Callable[[tuple, int], str],
+) -> Iterator[dict]:  # fmt: skip
     actors: list[Any] = []
     try:
         actors = [_RoomWorker.remote() for _ in range(min(workers, len(jobs)))]
@@ -73,12 +75,14 @@ def _run(
                 cause = exc.cause
                 if isinstance(cause, SgdataError):
                     raise cause from None
-                _retry(index, jobs, tries, retries, f"{type(cause).__name__}: {cause}")
+                why = f"{type(cause).__name__}: {cause}"
+                _retry(index, name(jobs[index], index), tries, retries, why)
                 queue.appendleft(index)
                 idle.append(actor)
                 continue
             except (RayActorError, WorkerCrashedError) as exc:
-                _retry(index, jobs, tries, retries, f"its worker died ({type(exc).__name__})")
+                why = f"its worker died ({type(exc).__name__})"
+                _retry(index, name(jobs[index], index), tries, retries, why)
                 queue.appendleft(index)
                 replacement = _RoomWorker.remote()
                 actors.append(replacement)
@@ -91,13 +95,10 @@ def _run(
             ray.kill(actor)
 
 
-def _retry(index: int, jobs: list[tuple], tries: Counter[int], retries: int, why: str) -> None:
+def _retry(index: int, task: str, tries: Counter[int], retries: int, why: str) -> None:
     tries[index] += 1
     if tries[index] > retries:
-        raise WorkerError(
-            f"{task_name(jobs[index], index)} failed {tries[index]} times on Ray ({why}); "
-            "rerun with --resume"
-        )
+        raise WorkerError(f"{task} failed {tries[index]} times on Ray ({why}); rerun with --resume")
 
 
 @contextmanager

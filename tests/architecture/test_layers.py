@@ -66,7 +66,8 @@ def _imports(
     )
     for node in ast.walk(tree):
         if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
-            found.add(node.module)
+            found.add(node.module)  # and each name, which may be a submodule of a package:
+            found.update(f"{node.module}.{a.name}" for a in node.names)  # _owner settles it
         elif isinstance(node, ast.Import):
             found.update(a.name for a in node.names)
         elif resolves and isinstance(node, ast.Constant) and isinstance(node.value, str):
@@ -181,6 +182,16 @@ def test_a_circle_closed_by_a_dynamic_import_is_found(tmp_path: Path, load: str)
     """A registry that imports its entries by name or file, and an entry that imports the
     registry: no ``import`` statement closes the circle, the check still sees it."""
     (tmp_path / "registry.py").write_text(DYNAMIC_LOADS[load])
+    (tmp_path / "entry.py").write_text("from pkg.registry import TABLE\n")
+    modules = [("pkg.registry", tmp_path / "registry.py"), ("pkg.entry", tmp_path / "entry.py")]
+    with pytest.raises(pytest.fail.Exception, match="pkg.entry -> pkg.registry"):
+        _assert_no_cycle(modules, "pkg")
+
+
+def test_a_circle_closed_by_importing_a_module_from_its_package_is_found(tmp_path: Path) -> None:
+    """``from pkg import entry`` names the module ``entry``, not the package's face (the
+    executors' deferred ``from sgdata.pipeline import ray_executor`` hid such a circle)."""
+    (tmp_path / "registry.py").write_text("def load():\n    from pkg import entry\n")
     (tmp_path / "entry.py").write_text("from pkg.registry import TABLE\n")
     modules = [("pkg.registry", tmp_path / "registry.py"), ("pkg.entry", tmp_path / "entry.py")]
     with pytest.raises(pytest.fail.Exception, match="pkg.entry -> pkg.registry"):
