@@ -278,9 +278,10 @@ def build_map(
     from seannet.navigation.localizer import open_localizer
     from seannet.navigation.maps import build_maps
 
-    rooms = room or list(open_dataset(data).rooms(split))
-    localizer = open_localizer(run, data, require_epsilon=False)  # a map needs no epsilon
-    for path in build_maps(localizer, data, rooms, out, layout=layout, spacing=spacing):
+    ds = open_dataset(data)
+    rooms = room or list(ds.rooms(split))
+    localizer = open_localizer(run, ds, require_epsilon=False)  # a map needs no epsilon
+    for path in build_maps(localizer, ds, rooms, out, layout=layout, spacing=spacing):
         console.print(f"map {path}")
 
 
@@ -498,13 +499,13 @@ def benchmark(
         )  # fmt: skip
     except ValueError:
         raise typer.BadParameter("--seeds takes integers, --lrs numbers, comma-separated") from None
+    dataset = open_dataset(data)  # every method's seeds, saved method, card and test share it
     navigation = None
     if navigator is not None:
         test = NavigationTestConfig(episodes=episodes)
         navigation = partial(
-            navigation_test, navigator=navigator, data=data, config=test, workers=workers
+            navigation_test, navigator=navigator, data=dataset, config=test, workers=workers
         )
-    dataset = open_dataset(data)  # every method's seeds, saved method and card share it
     for name in [m.strip() for m in methods.split(",") if m.strip()]:
         card = benchmark_method(
             name, dataset, out, config, announce=console.print, navigation=navigation

@@ -35,7 +35,7 @@ import torch
 import torch.nn.functional as F
 
 from seannet.data.collate import ViewTensors, collate_views
-from seannet.data.opening import DataSource, dataset_identity
+from seannet.data.opening import DataSource, dataset_identity, open_dataset
 from seannet.data.view_inputs import ImageTransform
 from seannet.errors import MethodError
 from seannet.methods.checks import (
@@ -240,7 +240,7 @@ def _read_record(path: Path) -> dict[str, Any]:
 
 def open_method(
     target: str | Path,
-    data: Path,
+    data: DataSource,
     *,
     epsilon: float | None = None,
     source: str = "--epsilon",
@@ -259,7 +259,8 @@ def open_method(
             directory fit on another dataset's vocabulary; no epsilon when one is required.
     """
     directory = Path(target)
-    identity = dataset_identity(data)
+    ds = open_dataset(data)
+    identity = dataset_identity(ds)
     if (directory / METHOD_FILE).is_file():
         record = _read_record(directory / METHOD_FILE)
         name = record["name"]
@@ -272,7 +273,7 @@ def open_method(
             if any(fitted.get(k) != identity.get(k) for k in MODEL_KEYS):
                 raise MethodError(
                     f"{directory}: method {name!r} was fit on another dataset's vocabulary "
-                    f"than {data}'s"
+                    f"than {ds.root}'s"
                 )
             blob = state.read_bytes()
             method = _restore(name, factory, blob, state)

@@ -36,6 +36,7 @@ from PIL import Image, ImageDraw, ImageFont
 
 from seannet.data.datasets import dataset_identity, open_dataset
 from seannet.data.live_views import LiveRooms
+from seannet.data.opening import DataSource
 from seannet.errors import NavigationError
 from seannet.methods.cards import method_label
 from seannet.navigation.config import MAP_SPACING, NavigationTestConfig
@@ -78,7 +79,7 @@ PARTS = "parts"
 def run_navigation(
     runs: list[Path | str],
     navigator: Path | None,
-    data: Path,
+    data: DataSource,
     config: NavigationTestConfig | None = None,
     *,
     epsilon: float | dict[Path, tuple[float, str]] | None = None,
@@ -126,9 +127,9 @@ def run_navigation(
         load_navigator(navigator)  # refuses a localizer run given as the navigator, here
     rooms = list(ds.rooms(config.split)) if config.split in ds.splits else []
     if not rooms:
-        raise NavigationError(f"{data}: split {config.split!r} has no room to navigate in")
+        raise NavigationError(f"{ds.root}: split {config.split!r} has no room to navigate in")
     say = progress or (lambda _: None)
-    localizers = [_localizer(run, data, epsilon) for run in runs]
+    localizers = [_localizer(run, ds, epsilon) for run in runs]
     settings = {
         **config.settings(),
         "navigator": str(navigator) if navigator is not None else ORACLE,
@@ -137,14 +138,14 @@ def run_navigation(
     }
     labels = dict(zip(runs, run_labels(runs), strict=True))
     named = dict(zip(runs, localizers, strict=True))
-    _build_maps(named, data, rooms, {r: maps / labels[r] for r in runs}, config, workers, say)
+    _build_maps(named, ds.root, rooms, {r: maps / labels[r] for r in runs}, config, workers, say)
     jobs = {
         (run, room_id, case): _job(settings, run, loc, labels[run], room_id, case, maps, strips)
         for run, loc in named.items()
         for room_id in rooms
         for case in CASES
     }
-    todo = [(job, str(data), str(out)) for job in jobs.values() if _part(job, out) is None]
+    todo = [(job, str(ds.root), str(out)) for job in jobs.values() if _part(job, out) is None]
     for done in run_tasks(_case_task, todo, workers=workers):
         say(f"{done['label']}: {done['room_id']} {done['case']} done")
     results: dict[str, Any] = {**settings, "config": dataclasses.asdict(config), "runs": []}
@@ -261,7 +262,7 @@ def seed_maps(
 
 
 def _localizer(
-    run: Path | str, data: Path, epsilon: float | dict[Path, tuple[float, str]] | None
+    run: Path | str, data: DataSource, epsilon: float | dict[Path, tuple[float, str]] | None
 ) -> AnyLocalizer:
     if isinstance(epsilon, dict):
         given, source = epsilon.get(run, (None, ""))  # type: ignore[call-overload]
@@ -330,8 +331,9 @@ def _one_thread() -> None:
 def _map_task(run: str, data: Path, room_id: str, directory: Path, spacing: int) -> dict:
     """Build (or reuse) one room's map by one run (in a worker)."""
     _one_thread()
-    localizer = open_localizer(run, data, require_epsilon=False)
-    with LiveRooms(data) as live:
+    ds = open_dataset(data)  # once per task: a worker has no handle of the command's
+    localizer = open_localizer(run, ds, require_epsilon=False)
+    with LiveRooms(ds) as live:
         ensure_map(localizer, live, room_id, directory, spacing=spacing)
     return {"run": str(run), "room_id": room_id}
 
@@ -339,7 +341,8 @@ def _map_task(run: str, data: Path, room_id: str, directory: Path, spacing: int)
 def _case_task(job: dict[str, Any], data: str, out: str) -> dict:
     """Every episode of one (run, room, case), written as one part file (in a worker)."""
     _one_thread()
-    localizer = open_localizer(job["run"], Path(data), epsilon=job["epsilon"])
+    ds = open_dataset(data)  # once per task: a worker has no handle of the command's
+    localizer = open_localizer(job["run"], ds, epsilon=job["epsilon"])
     navigator = job["navigator"]
     policy = None if navigator == ORACLE else load_navigator(Path(navigator))
     directory = Path(job["map"])
@@ -348,7 +351,7 @@ def _case_task(job: dict[str, Any], data: str, out: str) -> dict:
     room_id, case = job["room_id"], job["case"]
     records = []
     drawn: set[str] = set()  # the outcome kinds drawn as strips already
-    with LiveRooms(Path(data)) as live:
+    with LiveRooms(ds) as live:
         for index in range(job["episodes_per_case_and_room"]):
             rng = rng_for(episode_seed(job["seed"], room_id, case, index))
             episode = sample_episode(topo, live, case, rng, index=index)

@@ -24,6 +24,7 @@ import numpy as np
 import torch
 
 from seannet.data.datasets import ImageTransform, ViewTensors, collate_views
+from seannet.data.opening import DataSource, open_dataset
 from seannet.errors import NavigationError
 from seannet.evaluation.run_eval import eval_file
 from seannet.methods.localizer import METHOD_FILE, MethodLocalizer, open_method
@@ -102,7 +103,7 @@ def run_epsilon(run: Path) -> tuple[float, str] | None:
 
 def load_localizer(
     run: Path,
-    data: Path,
+    data: DataSource,
     *,
     epsilon: float | None = None,
     source: str = "--epsilon",
@@ -112,7 +113,7 @@ def load_localizer(
 
     Args:
         run: the run directory.
-        data: the dataset the run was trained on.
+        data: the dataset the run was trained on (opened already, or its root).
         epsilon: the threshold to use; None reads the run's eval files (:func:`run_epsilon`).
         source: where a given ``epsilon`` comes from (reported beside it).
         require_epsilon: without one, raise (True) or leave epsilon NaN (building maps).
@@ -121,7 +122,8 @@ def load_localizer(
         CheckpointError: no checkpoint, or it was trained on another dataset.
         NavigationError: no epsilon given and the run has no evaluated threshold.
     """
-    restored = restore_run(run, data)
+    ds = open_dataset(data)
+    restored = restore_run(run, ds)
     if epsilon is None:
         found = run_epsilon(run)
         if found is None and not require_epsilon:
@@ -129,7 +131,7 @@ def load_localizer(
         if found is None:
             raise NavigationError(
                 f"{run}: no eval_<split>.json with threshold.epsilon; run `seannet eval {run} "
-                f"--data {data} --split test` first, or pass --epsilon"
+                f"--data {ds.root} --split test` first, or pass --epsilon"
             )
         epsilon, source = found
     if require_epsilon and not math.isfinite(epsilon):
@@ -152,7 +154,7 @@ AnyLocalizer = Localizer | MethodLocalizer
 
 def open_localizer(
     target: str | Path,
-    data: Path,
+    data: DataSource,
     *,
     epsilon: float | None = None,
     source: str = "--epsilon",

@@ -27,6 +27,7 @@ import numpy as np
 from seannet.data.datasets import ObservationDataset, dataset_identity, open_dataset
 from seannet.data.live_views import layout_boxes
 from seannet.data.moved import BIN_NAMES, moved_bin, moved_instances
+from seannet.data.opening import DataSource
 from seannet.errors import DataError, MapError
 from seannet.evaluation.retrieval import recall_at_k
 from seannet.markdown import table
@@ -65,7 +66,7 @@ def _open_maps(localizer: AnyLocalizer, paths: list[Path]) -> list[TopoMap]:
     return maps
 
 
-def _find_views(data: Path, obs_ids: list[str], localizer: AnyLocalizer) -> dict[str, Any]:
+def _find_views(data: DataSource, obs_ids: list[str], localizer: AnyLocalizer) -> dict[str, Any]:
     """obs id -> ObservationItem, searching every split of ``data``.
 
     Raises:
@@ -81,27 +82,34 @@ def _find_views(data: Path, obs_ids: list[str], localizer: AnyLocalizer) -> dict
                 found[o] = views[index[o]]
     missing = [o for o in obs_ids if o not in found]
     if missing:
-        raise DataError(f"{data}: observation {missing[0]!r} is in none of its splits")
+        raise DataError(f"{ds.root}: observation {missing[0]!r} is in none of its splits")
     return found
 
 
-def _check_query_data(localizer: AnyLocalizer, data: Path) -> None:
+def _check_query_data(localizer: AnyLocalizer, data: DataSource) -> None:
     """A query dataset must share the run's vocabulary (a photo dataset is another dataset)."""
-    current = dataset_identity(data)
+    ds = open_dataset(data)
+    current = dataset_identity(ds)
     for key in MODEL_KEYS:
         if current.get(key) != localizer.identity.get(key):
             raise DataError(
-                f"{data}/dataset.json: {key} differs from the dataset {localizer.source} was "
+                f"{ds.root}/dataset.json: {key} differs from the dataset {localizer.source} was "
                 f"trained on; queries need the same class vocabulary"
             )
 
 
 def localize_queries(
-    localizer: AnyLocalizer, maps: list[TopoMap], data: Path, queries: list[str], *, top: int = TOP
+    localizer: AnyLocalizer,
+    maps: list[TopoMap],
+    data: DataSource,
+    queries: list[str],
+    *,
+    top: int = TOP,
 ) -> list[dict[str, Any]]:
     """The best ``top`` sub-nodes for each query (see the module doc)."""
-    _check_query_data(localizer, data)
-    items = _find_views(data, queries, localizer)
+    ds = open_dataset(data)
+    _check_query_data(localizer, ds)
+    items = _find_views(ds, queries, localizer)
     vectors = localizer.embed([items[q].view for q in queries])
     out = []
     for q, vector in zip(queries, vectors, strict=True):
@@ -128,7 +136,7 @@ def localize_queries(
 
 
 def retrieval(
-    localizer: AnyLocalizer, maps: list[TopoMap], data: Path, split: str
+    localizer: AnyLocalizer, maps: list[TopoMap], data: DataSource, split: str
 ) -> dict[str, Any]:
     """Recall@1 / @5 of the true sub-node for the split's views in other layouts.
 
@@ -156,11 +164,11 @@ def retrieval(
     rows = []
     for room_id, queries in picked.items():
         topo = rooms[room_id]
-        boxes = {topo.layout: layout_boxes(data, room_id, topo.layout)}
+        boxes = {topo.layout: layout_boxes(ds.root, room_id, topo.layout)}
         vectors = localizer.embed([views[position[q["obs_id"]]].view for q in queries])
         for q, vector in zip(queries, vectors, strict=True):
             if q["layout"] not in boxes:
-                boxes[q["layout"]] = layout_boxes(data, room_id, q["layout"])
+                boxes[q["layout"]] = layout_boxes(ds.root, room_id, q["layout"])
             moved = moved_instances(boxes[topo.layout], boxes[q["layout"]])
             true_row = topo.index((q["grid_i"], q["grid_j"], q["heading"]))
             sims = _sims(localizer, topo, vector)
@@ -196,7 +204,7 @@ def _summarise(rows: list[dict[str, Any]], epsilon: float, split: str) -> dict[s
 def run_localize(
     run: Path | str,
     map_path: Path,
-    data: Path,
+    data: DataSource,
     *,
     queries: list[str] | None = None,
     split: str | None = None,
@@ -225,7 +233,10 @@ def run_localize(
     source = Path(str(first.meta.get("data", "")))
     if not (source / MANIFEST).is_file():
         raise MapError(f"{paths[0]}/map.json: data {str(source)!r} is not a dataset any more")
-    localizer = open_localizer(run, source, epsilon=epsilon)
+    ds = open_dataset(data)
+    # the map's dataset is most often the queries' own: one opening serves both
+    same = source.resolve() == ds.root.resolve()
+    localizer = open_localizer(run, ds if same else source, epsilon=epsilon)
     maps = _open_maps(localizer, paths)
     head = {
         "run": str(run),
@@ -235,11 +246,11 @@ def run_localize(
         "maps": [str(p) for p in paths],
     }
     if queries is not None:
-        result = {**head, "queries": localize_queries(localizer, maps, data, queries, top=top)}
+        result = {**head, "queries": localize_queries(localizer, maps, ds, queries, top=top)}
         name, text = "localize", _queries_markdown(result)
     else:
         assert split is not None
-        result = {**head, **retrieval(localizer, maps, data, split)}
+        result = {**head, **retrieval(localizer, maps, ds, split)}
         name, text = f"localize_{split}", _retrieval_markdown(result)
     out = out or Path(run)
     atomic_write_text(out / f"{name}.json", json.dumps(result, indent=2))

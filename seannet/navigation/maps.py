@@ -35,6 +35,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from seannet.data.live_views import LiveRooms
+from seannet.data.opening import DataSource
 from seannet.errors import MapError
 from seannet.navigation.config import MAP_SPACING
 from seannet.navigation.localizer import AnyLocalizer
@@ -422,7 +423,7 @@ def map_dirs(path: Path) -> list[Path]:
 
 def build_maps(
     localizer: AnyLocalizer,
-    data: Path,
+    data: DataSource,
     rooms: list[str],
     out: Path,
     *,

@@ -14,6 +14,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from seannet.data.opening import DataSource
 from seannet.navigation.benchmark import run_navigation
 from seannet.navigation.config import NavigationTestConfig
 from seannet.navigation.episodes import OUTCOMES
@@ -28,7 +29,7 @@ def navigation_test(
     directory: Path,
     *,
     navigator: Path,
-    data: Path,
+    data: DataSource,
     config: NavigationTestConfig,
     workers: int = 1,
 ) -> dict[str, Any]:

@@ -10,6 +10,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+from seannet.data.opening import DataSource, open_dataset
 from seannet.errors import NavigationError
 from seannet.navigation.benchmark import run_labels, run_navigation
 from seannet.navigation.config import NavigationTestConfig
@@ -57,7 +58,7 @@ def best_epsilon(grid: Sequence[dict[str, Any]]) -> float:
 def choose_epsilon(
     runs: list[Path],
     navigator: Path | None,
-    data: Path,
+    data: DataSource,
     out: Path,
     config: NavigationTestConfig | None = None,
     *,
@@ -82,6 +83,7 @@ def choose_epsilon(
         raise NavigationError(
             "a stop threshold is chosen on val rooms, never on test: pass a config of split val"
         )
+    data = open_dataset(data)  # every threshold's test shares one opening
     say = progress or (lambda _: None)
     rows = []
     for run, label in zip(runs, run_labels(runs), strict=True):

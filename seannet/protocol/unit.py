@@ -201,10 +201,10 @@ def _full_map(
     directory.mkdir(parents=True, exist_ok=True)
     save_method(directory, name, method, epsilon=result["threshold"]["epsilon"],
                 epsilon_source="val (protocol unit)", data=ds)  # fmt: skip
-    localizer = open_localizer(directory, ds.root, require_epsilon=False)
+    localizer = open_localizer(directory, ds, require_epsilon=False)
     rooms = list(ds.rooms("test"))
-    build_maps(localizer, ds.root, rooms, directory / "maps", spacing=design.map_spacing)
-    got = run_localize(directory, directory / "maps", ds.root, split="test", out=directory)
+    build_maps(localizer, ds, rooms, directory / "maps", spacing=design.map_spacing)
+    got = run_localize(directory, directory / "maps", ds, split="test", out=directory)
     return {
         "spacing": design.map_spacing,
         "rooms": len(rooms),

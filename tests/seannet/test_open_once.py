@@ -111,3 +111,40 @@ def test_benchmark_reads_the_manifest_once(
     )  # fmt: skip
     assert done.returncode == 0, done.stderr
     assert manifest_reads.of(mini_dataset) == 1
+
+
+def test_map_localize_and_navigate_read_the_manifest_once_each(
+    tmp_path: Path, mini_dataset: Path, localizer_run: Path, manifest_reads: ManifestReads
+) -> None:
+    # the localizer's identity, the live rooms that render the sub-nodes, the maps and the
+    # queries' loader share the command's one opening (navigate's episodes run in worker
+    # processes, which open their own)
+    maps = tmp_path / "maps"
+    done = run_cli("seannet", "map", localizer_run, "--data", mini_dataset, "--out", maps)
+    assert done.returncode == 0, done.stderr
+    assert manifest_reads.of(mini_dataset) == 1
+    done = run_cli(
+        "seannet", "localize", localizer_run, "--map", maps, "--data", mini_dataset,
+        "--split", "test", "--epsilon", "0.9", "--out", tmp_path / "loc",
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert manifest_reads.of(mini_dataset) == 2
+    done = run_cli(
+        "seannet", "navigate", localizer_run, "--data", mini_dataset, "--oracle",
+        "--episodes", "1", "--epsilon", "0.9", "--maps", maps, "--out", tmp_path / "nav",
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert manifest_reads.of(mini_dataset) == 3
+
+
+def test_benchmark_with_its_navigation_test_reads_the_manifest_once(
+    tmp_path: Path, mini_dataset: Path, navigation_run: Any, manifest_reads: ManifestReads
+) -> None:
+    done = run_cli(
+        "seannet", "benchmark", "--data", mini_dataset, "--methods", "tiny-image",
+        "--out", tmp_path / "cards", "--seeds", "0", "--navigator", navigation_run.navigator,
+        "--episodes", "1",
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "cards" / "tiny-image" / "navigation").is_dir()
+    assert manifest_reads.of(mini_dataset) == 1
