@@ -481,10 +481,18 @@ def benchmark(
         int, typer.Option(help="Navigation episodes per case (N, A) and room.")
     ] = NAVIGATION_TEST.episodes,
     workers: Annotated[int, typer.Option(help="Navigation worker processes.")] = 1,
+    covisibility: Annotated[
+        bool,
+        typer.Option(
+            "--covisibility",
+            help="Also run the covisibility oracle on test (depth and poses; once per command) "
+            "and give each method's accuracy on the triplets the views decide beside all.",
+        ),
+    ] = False,
 ) -> None:
     """DESIGN §12's protocol for any method: choices on val, test once, the change sweep, box
-    noise, cost, and with --navigator the navigation test; one card per method (JSON,
-    markdown, sweep plot)."""
+    noise, cost, with --navigator the navigation test and with --covisibility the accuracy
+    on the triplets the views decide; one card per method (JSON, markdown, sweep plot)."""
     from functools import partial
 
     from seannet.data.opening import open_dataset
@@ -506,10 +514,14 @@ def benchmark(
         navigation = partial(
             navigation_test, navigator=navigator, data=dataset, config=test, workers=workers
         )
+    oracle = None
+    if covisibility:
+        from seannet.evaluation.covisibility_oracle import oracle as covisibility_oracle
+
+        oracle = covisibility_oracle(dataset, "test", say=console.print)
     for name in [m.strip() for m in methods.split(",") if m.strip()]:
-        card = benchmark_method(
-            name, dataset, out, config, announce=console.print, navigation=navigation
-        )
+        card = benchmark_method(name, dataset, out, config, announce=console.print,
+                                navigation=navigation, covisibility=oracle)  # fmt: skip
         typer.echo(card.with_name("card.md").read_text())
         console.print(f"wrote {card} and its .md, sweep.png")
 

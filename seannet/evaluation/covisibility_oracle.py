@@ -22,7 +22,7 @@ import numpy as np
 
 from seannet.data.opening import DataSource, open_dataset
 
-__all__ = ["DIRECTIONS", "oracle", "step_direction"]
+__all__ = ["DIRECTIONS", "decidable", "decidable_by_tier", "oracle", "step_direction"]
 
 # One letter per triplet in a record: same cell, along the view axis, across it, both
 DIRECTIONS = {"s": "same cell", "a": "along", "c": "across", "m": "mixed"}
@@ -104,6 +104,44 @@ def oracle(
         "views": len(needed),
         "disagreements": _examples(rows, tiers, directions, correct, scores, EXAMPLES),
     }
+
+
+def decidable(oracle_correct: str, outcomes: np.ndarray) -> dict[str, Any]:
+    """A method's accuracy on all triplets, on those the views decide (the oracle, string
+    ``oracle_correct`` of :func:`oracle`, agrees with the label) and on the others.
+
+    ``outcomes``: each triplet right (1) or wrong (0) in the split's row order, one row per
+    seed (or one row); accuracies are means over seeds. "Not decidable" is NaN when every
+    triplet is decidable.
+    """
+    right = np.array([c == "1" for c in oracle_correct])
+    per_triplet = np.atleast_2d(np.asarray(outcomes, dtype=np.float64)).mean(axis=0)
+    if per_triplet.shape != right.shape:
+        raise ValueError(
+            f"{per_triplet.size} outcomes per seed for {right.size} triplets of the oracle: "
+            "both must be of the same split, in its row order"
+        )
+    return {
+        "triplets": int(right.size),
+        "decidable_triplets": int(right.sum()),
+        "oracle_accuracy": float(right.mean()) if right.size else float("nan"),
+        "accuracy": float(per_triplet.mean()) if right.size else float("nan"),
+        "decidable": float(per_triplet[right].mean()) if right.any() else float("nan"),
+        "not_decidable": float(per_triplet[~right].mean()) if (~right).any() else float("nan"),
+    }
+
+
+def decidable_by_tier(result: dict[str, Any], outcomes: np.ndarray) -> dict[str, Any]:
+    """:func:`decidable` on every triplet of the oracle's ``result`` (:func:`oracle`), and
+    per tier under ``per_tier``; ``outcomes`` as :func:`decidable` takes them."""
+    outcomes = np.atleast_2d(np.asarray(outcomes, dtype=np.float64))
+    tiers = np.array([int(t) for t in result["tier"]])
+    per_tier = {}
+    for tier in sorted(set(tiers.tolist())):
+        rows = np.flatnonzero(tiers == tier)
+        correct = "".join(result["correct"][k] for k in rows)
+        per_tier[str(tier)] = decidable(correct, outcomes[:, rows])
+    return {**decidable(result["correct"], outcomes), "per_tier": per_tier}
 
 
 def _examples(

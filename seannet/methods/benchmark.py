@@ -14,6 +14,10 @@ For each method (a name, an import path or a model spec, :func:`load_method`) an
 4. with a ``navigation`` test given (``seannet benchmark --navigator RUN``): the paper's
    navigation test with the first seed's method as localizer (its epsilon from val), its
    success and failure rates in the card.
+5. with the covisibility oracle given (``seannet benchmark --covisibility``): accuracy on the
+   test triplets the views decide (the oracle agrees with the label) beside all of them,
+   overall and per tier, the mean over seeds of each triplet's outcome
+   (:mod:`seannet.evaluation.covisibility_oracle`; a diagnostic, the oracle is no method).
 
 The first seed's method is kept in the card's directory as a method directory
 (:func:`~seannet.methods.localizer.save_method`: ``method.json``, and ``method.pt`` for a
@@ -46,6 +50,7 @@ from seannet.data.box_noise import BoxNoise
 from seannet.data.datasets import ImageTransform, ObservationDataset, collate_views
 from seannet.data.opening import DataSource, open_dataset
 from seannet.errors import MethodError
+from seannet.evaluation.covisibility_oracle import decidable_by_tier
 from seannet.evaluation.intervals import (
     per_room_matrix,
     t_interval,
@@ -421,6 +426,7 @@ def benchmark_method(
     *,
     announce: Callable[[str], None] | None = None,
     navigation: Callable[[Path], dict[str, Any]] | None = None,
+    covisibility: dict[str, Any] | None = None,
 ) -> Path:
     """Run the protocol for one method on ``data`` (an opened dataset, or its root: opened
     once here, for every seed, the saved method and the card) and write its card under
@@ -430,6 +436,9 @@ def benchmark_method(
         navigation: the navigation test of a method directory (the first seed's method, saved
             in the card's directory), returning its summary for the card; the navigation stage
             provides it (:func:`seannet.navigation.method_navigation.navigation_test`).
+        covisibility: the covisibility oracle on ``data``'s test split
+            (:func:`seannet.evaluation.covisibility_oracle.oracle`): the card says the
+            method's accuracy on the triplets the views decide.
 
     Raises:
         MethodError: the method cannot be loaded or broke a check (no card is written).
@@ -440,6 +449,14 @@ def benchmark_method(
     say = announce or (lambda _text: None)
     factory, _ = load_method(name)
     dataset = open_dataset(data)
+    if covisibility is not None:
+        test = dataset.triplets("test").num_rows
+        if covisibility.get("split") != "test" or covisibility.get("triplets") != test:
+            raise MethodError(
+                f"method {name!r}: the covisibility oracle given is not of this dataset's test "
+                f"split ({covisibility.get('triplets')} triplets of {covisibility.get('split')!r}"
+                f"; test has {test})"
+            )
     work = out / "runs"
     first, method = run_seed(name, factory, dataset, config, config.seeds[0], work, say)
     runs = [first]
@@ -449,6 +466,9 @@ def benchmark_method(
             run_seed(name, factory, dataset, config, s, work, say)[0] for s in config.seeds[1:]
         ]
     summary = summarize(runs)
+    if covisibility is not None:
+        outcomes = np.array([[c == "1" for c in r["test_correct"]] for r in runs])
+        summary["covisibility"] = decidable_by_tier(covisibility, outcomes)
     directory = card_dir(out, name)
     directory.mkdir(parents=True, exist_ok=True)
     save_method(directory, name, method, epsilon=first["threshold"]["epsilon"],

@@ -163,6 +163,8 @@ def _markdown(card: dict[str, Any]) -> str:
         lines += table(
             list(bins), [[f"{pct(v['accuracy'])} ({v['triplets']})" for v in bins.values()]]
         )
+    if "covisibility" in s:
+        lines += _covisibility_lines(s["covisibility"])
     if "box_noise" in s:
         lines += ["", "Box noise (S jitter, P drop, Q spurious; accuracy %):", ""]
         lines += table(
@@ -190,6 +192,41 @@ def _small_data_warning(s: dict[str, Any]) -> list[str]:
         f"{FEW_ROOMS} rooms or {FEW_TRIPLETS} triplets): read the figures as a smoke test, "
         "not a ranking; a bin's count is beside its accuracy.",
         "",
+    ]
+
+
+def _covisibility_lines(c: dict[str, Any]) -> list[str]:
+    """Accuracy on the triplets the views decide (the covisibility oracle agrees with the
+    label) beside all of them and the others, overall and per tier."""
+
+    def cell(value: float) -> str:
+        return "-" if math.isnan(value) else pct(value)
+
+    rows = [
+        [tier, str(t["triplets"]), str(t["decidable_triplets"]), cell(t["oracle_accuracy"]),
+         cell(t["accuracy"]), cell(t["decidable"]), cell(t["not_decidable"])]
+        for tier, t in [*c["per_tier"].items(), ("all", c)]
+    ]  # fmt: skip
+    return [
+        "",
+        f"What the views decide (`--covisibility`): the covisibility oracle orders "
+        f"{c['decidable_triplets']} of {c['triplets']} test triplets as their label does "
+        f"({cell(c['oracle_accuracy'])} %); this method gets **{cell(c['decidable'])} %** of "
+        f"those and {cell(c['not_decidable'])} % of the others (chance: 50 %). The oracle "
+        "reads depth and poses: a diagnostic, not a method.",
+        "",
+        *table(
+            [
+                "tier",
+                "triplets",
+                "decidable",
+                "oracle %",
+                "accuracy %",
+                "decidable %",
+                "not decidable %",
+            ],
+            rows,
+        ),  # fmt: skip
     ]
 
 
@@ -322,7 +359,9 @@ def read_cards(paths: list[Path]) -> list[dict[str, Any]]:
 def leaderboard_rows(cards: list[dict[str, Any]], *, timing: bool = True) -> list[str]:
     """The leaderboard's table of ``cards``, best accuracy first (``timing``: with the ms per
     view each card measured, a figure of the machine that ran it)."""
-    header = ["method", "seeds", "accuracy % (rooms x seeds, 95 %)", "recall@1 %", "recall@5 %",
+    views = any("covisibility" in c["summary"] for c in cards)  # a --covisibility run
+    header = ["method", "seeds", "accuracy % (rooms x seeds, 95 %)",
+              *(["decidable %"] if views else []), "recall@1 %", "recall@5 %",
               "breaks at (moved objects)", *(["ms / view"] if timing else []), "bytes / entry",
               "navigation success % N / A"]  # fmt: skip
     titles = [c["method"] for c in cards]
@@ -331,6 +370,7 @@ def leaderboard_rows(cards: list[dict[str, Any]], *, timing: bool = True) -> lis
             _board_name(c, titles.count(c["method"]) > 1),
             str(c["summary"]["seeds"]) if c["trained"] else "- (no training)",
             _interval(c["summary"]["accuracy_rooms_seeds"]),
+            *([_decidable_cell(c)] if views else []),
             _interval(c["summary"]["recall1"]),
             _interval(c["summary"]["recall5"]),
             _breaks(c["summary"], "moved_objects"),
@@ -341,6 +381,12 @@ def leaderboard_rows(cards: list[dict[str, Any]], *, timing: bool = True) -> lis
         for c in sorted(cards, key=lambda c: -c["summary"]["accuracy"]["mean"])
     ]
     return table(header, rows)
+
+
+def _decidable_cell(card: dict[str, Any]) -> str:
+    """Accuracy % on the test triplets the views decide, or "-" for a card without it."""
+    c = card["summary"].get("covisibility")
+    return "-" if c is None or math.isnan(c["decidable"]) else pct(c["decidable"])
 
 
 def _board_name(card: dict[str, Any], shared: bool) -> str:
