@@ -12,7 +12,13 @@ from sgdata_cli.errors import run_app
 
 from seannet.model.config import BACKBONES
 from seannet.model.specs import MODEL_NAMES, spec_help
-from seannet.navigation.config import FUSIONS, MAP_SPACING, NavigationTestConfig, NavigatorConfig
+from seannet.navigation.config import (
+    FUSIONS,
+    MAP_SPACING,
+    STOP_POLICY_VAL_EPISODES,
+    NavigationTestConfig,
+    NavigatorConfig,
+)
 from seannet.seeds import DEFAULT_SEEDS
 from seannet.training.config import DEFAULT_PRESET, PRESETS
 from sgdata.errors import SgdataError
@@ -417,6 +423,18 @@ def navigate(
     ] = None,
     maps: Annotated[Path | None, typer.Option(help="Maps cache (default: OUT/maps).")] = None,
     strips: Annotated[Path | None, typer.Option(help="Save a few episodes as strips.")] = None,
+    stop_policy: Annotated[
+        bool,
+        typer.Option(
+            "--stop-policy",
+            help="Choose each localizer's stop rule on val episodes for navigation success "
+            "(the paper's S > epsilon, relative to rival sub-nodes, over a window of views), "
+            "then judge the test episodes by it and by the paper's rule.",
+        ),
+    ] = False,
+    val_episodes: Annotated[
+        int, typer.Option(help="--stop-policy: val episodes per case and room to choose on.")
+    ] = STOP_POLICY_VAL_EPISODES,
 ) -> None:
     """The navigation test (paper Table II): success and failure rates, N / A, per localizer.
     Resumes where a killed run stopped."""
@@ -429,6 +447,10 @@ def navigate(
     config = NavigationTestConfig(
         split=split, episodes=episodes, seed=seed, spacing=spacing, replan=replan
     )
+    if stop_policy:
+        _navigate_stop_policy(runs, navigator, data, config, val_episodes, workers, out,
+                              epsilon=epsilon, strips=strips)  # fmt: skip
+        return
     with console.status("navigate") as status:
         result = run_navigation(
             runs, navigator, data, config, epsilon=epsilon, workers=workers, out=out, maps=maps,
@@ -441,6 +463,35 @@ def navigate(
         for row in rate_rows(result, rule):
             table.add_row(*row)
         console.print(table)
+    console.print(f"wrote {result['written']} and its .json")
+
+
+def _navigate_stop_policy(
+    runs: list[str],
+    navigator: Path | None,
+    data: Path,
+    config: NavigationTestConfig,
+    val_episodes: int,
+    workers: int,
+    out: Path | None,
+    *,
+    epsilon: float | None,
+    strips: Path | None,
+) -> None:
+    """``seannet navigate --stop-policy``: the choice on val, the test rows, the markdown."""
+    from seannet.errors import NavigationError
+    from seannet.navigation.stop_policy import choose_and_test
+
+    if strips is not None:
+        raise NavigationError("--stop-policy draws no strips: leave out --strips")
+    where = out if out is not None else navigator
+    if where is None:
+        raise NavigationError("the oracle navigator has no run directory: pass --out")
+    with console.status("navigate --stop-policy") as status:
+        result = choose_and_test(runs, navigator, data, where, config, epsilon=epsilon,
+                                 workers=workers, val_episodes=val_episodes,
+                                 progress=status.update)  # fmt: skip
+    typer.echo(Path(result["written"]).read_text())
     console.print(f"wrote {result['written']} and its .json")
 
 

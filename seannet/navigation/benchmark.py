@@ -296,7 +296,7 @@ def run_labels(runs: list[Path | str]) -> list[str]:
 
 # What a part depends on: the test's settings, the run and its threshold, the room and case.
 _KEY_FIELDS = (
-    "split", "episodes_per_case_and_room", "seed", "k_max", "spacing", "replan",
+    "split", "episodes_per_case_and_room", "seed", "k_max", "spacing", "replan", "trace",
     "navigator_sha256", "dataset", "run", "checkpoint_sha256", "epsilon", "room_id", "case",
 )  # fmt: skip
 
@@ -359,7 +359,7 @@ def _case_task(job: dict[str, Any], data: str, out: str) -> dict:
             started = time.perf_counter()
             result = run_episode(
                 episode, topo, live, localizer, policy,
-                k_max=job["k_max"], replan=job["replan"], keep_frames=keep,
+                k_max=job["k_max"], replan=job["replan"], keep_frames=keep, trace=job["trace"],
             )  # fmt: skip
             record = result.to_dict()
             record["seconds"]["total"] = time.perf_counter() - started

@@ -19,6 +19,7 @@ __all__ = [
     "K_MAX",
     "MAP_SPACING",
     "RULES",
+    "STOP_POLICY_VAL_EPISODES",
     "NavigationTestConfig",
     "NavigatorConfig",
 ]
@@ -29,6 +30,9 @@ FUSIONS = ("early", "late")  # NavigatorConfig.fusion
 # how an episode's collision is judged: the paper's (it ends the episode) and, beyond the
 # paper, bump and replan (the robot stays, the map path is planned again from where it stands)
 RULES = ("paper", "replan")
+# val episodes per case and room a stop policy is chosen on (seannet navigate --stop-policy):
+# 400 per case on medium's 8 val rooms
+STOP_POLICY_VAL_EPISODES = 50
 
 
 @dataclass(frozen=True)
@@ -103,6 +107,9 @@ class NavigationTestConfig:
     k_max: int = K_MAX  # steps per segment
     spacing: int = MAP_SPACING  # cells between map nodes
     replan: bool = False  # also run bump and replan (its paper-rule outcome read off the same run)
+    # trace every segment for stop rules judged offline (seannet.navigation.stopping); its
+    # paper-rule outcome is the one a plain run has
+    trace: bool = False
 
     def __post_init__(self) -> None:
         if self.episodes < 1:
@@ -111,6 +118,8 @@ class NavigationTestConfig:
             raise NavigationError(f"k_max {self.k_max}: expected >= 1 step per segment")
         if self.spacing < 1:
             raise NavigationError(f"--spacing {self.spacing}: expected >= 1 cell")
+        if self.trace and self.replan:
+            raise NavigationError("a traced test is judged under the paper's rule: no --replan")
 
     @property
     def rules(self) -> tuple[str, ...]:
@@ -130,6 +139,7 @@ class NavigationTestConfig:
             "k_max": self.k_max,
             "spacing": self.spacing,
             "replan": self.replan,
+            "trace": self.trace,
         }
 
     @classmethod
@@ -142,4 +152,5 @@ class NavigationTestConfig:
             k_max=results["k_max"],
             spacing=results["spacing"],
             replan=bool(results.get("replan", False)),
+            trace=bool(results.get("trace", False)),
         )

@@ -18,6 +18,14 @@ steps per segment. Judged per step (:func:`step_verdict`), first failure ends th
 - **navigation**: ``k_max`` steps without stopping and without a localization failure;
 - **success**: every segment stopped within half a cell and 10 degrees of its goal.
 
+A *traced* episode (``trace``, for stop policies chosen offline,
+:mod:`seannet.navigation.stopping`) never stops on S: each segment runs until the robot
+stands on its goal, collides or spends ``k_max`` steps, every step recording S to the goal,
+to the segment's start, to the plan's next sub-node and the best S among the map's other
+sub-nodes; the next segment starts on its start sub-node. The navigator's actions never
+depend on S, and a segment that ends well ends on its goal's pose, so any stop rule judged on
+the trace gives the outcome a run under that rule would have had; the paper's rule included.
+
 Beyond the paper (``replan``): a real robot feels a bump. A collision then marks the
 segment's map edge unusable for the episode, the robot localizes itself on the map with the
 localizer (its best sub-node) and Dijkstra plans again from there; the episode ends on any
@@ -26,6 +34,7 @@ other failure, when no path is left, or past a step budget (:func:`step_budget`)
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from collections.abc import Callable, Sequence
@@ -102,6 +111,12 @@ class Step:
     collided: bool = False
     similarity: float = float("nan")  # S(current view, goal sub-node); NaN after a collision
     cause: str | None = None  # a collision's: BLOCKED or NAVIGATOR_ERROR
+    # a traced episode's (run_episode(trace=True)) rival evidence: S to the segment's start
+    # sub-node, to the plan's next sub-node after the goal (NaN at the last goal), and the
+    # best S among the map's sub-nodes other than the goal
+    start_similarity: float = float("nan")
+    next_similarity: float = float("nan")
+    other_similarity: float = float("nan")
 
 
 def reached(pose: Pose, goal: Pose) -> bool:
@@ -266,6 +281,7 @@ class EpisodeResult:
     paper: tuple[str, int, str | None] = ("success", -1, None)
     replans: int = 0  # --replan: plans made again after a bump
     timing: Timing = field(default_factory=Timing)
+    traced: bool = False  # run_episode(trace=True): its steps' evidence goes into to_dict
 
     def to_dict(self) -> dict[str, Any]:
         """The episode as plain data; ``seconds`` is the only field that varies between runs."""
@@ -286,8 +302,24 @@ class EpisodeResult:
             "bumps": [s.cause for s in steps if s.collided],
             "goals": [list(goal) for goal, _ in self.segments],
             "actions": [[s.action for s in seg] for _, seg in self.segments],
+            **({"evidence": self.evidence()} if self.traced else {}),
             "seconds": self.timing.to_dict(),
         }
+
+    def evidence(self) -> list[list[list[Any]]]:
+        """Per segment, per step: ``[S goal, S start, S next, S other, on the goal, collision
+        cause]`` (a NaN as None; the cause "" when the step did not collide), what a stop rule
+        is judged on (:mod:`seannet.navigation.stopping`)."""
+
+        def number(value: float) -> float | None:
+            return None if math.isnan(value) else float(value)
+
+        return [
+            [[number(s.similarity), number(s.start_similarity), number(s.next_similarity),
+              number(s.other_similarity), reached(s.pose, goal) and not s.collided,
+              s.cause or ""] for s in steps]
+            for goal, steps in self.segments
+        ]  # fmt: skip
 
 
 def sample_episode(
@@ -343,6 +375,7 @@ def run_episode(
     k_max: int = K_MAX,
     replan: bool = False,
     keep_frames: bool = False,
+    trace: bool = False,
 ) -> EpisodeResult:
     """Run ``episode`` on the live renderer (see the module doc).
 
@@ -352,7 +385,15 @@ def run_episode(
             :func:`ideal_action` from the true pose (a bound that leaves only the localizer).
         replan: bump and replan (beyond the paper) instead of ending on a collision.
         keep_frames: keep every view (for strips).
+        trace: never stop on S; record every segment's evidence (see the module doc). Its
+            outcome is the paper rule's, judged on the trace.
+
+    Raises:
+        NavigationError: ``trace`` with ``replan`` (a trace is judged under the paper's
+            collision rule).
     """
+    if trace and replan:
+        raise NavigationError("a traced episode is judged under the paper's rule: no replan")
     live.load(episode.room_id, episode.layout)
     clock = Timing()
     pose = episode.path[0]
@@ -370,7 +411,11 @@ def run_episode(
             verdict = None
             break
         a, b = plan[n], plan[n + 1]
+        if trace and pose != a:  # every traced segment starts on its start sub-node
+            pose = a
+            current = clock.timed("render", live.view, *pose)
         goal_vector, goal_image = topo.embedding(b), topo.image(b)
+        rivals = _Rivals(topo, a, b, plan[n + 2] if n + 2 < len(plan) else None) if trace else None
         steps: list[Step] = []
         verdict = None
         while verdict is None and len(steps) < min(k_max, budget - used):
@@ -389,14 +434,21 @@ def run_episode(
                 pose = nxt
                 current = clock.timed("render", live.view, *pose)
                 vector = clock.timed("embed", _embed, localizer, live, current)
-                similarity = localizer.similarities(vector, goal_vector[None])[0]
-                steps.append(Step(action, pose, similarity=float(similarity)))
+                similarity = float(localizer.similarities(vector, goal_vector[None])[0])
+                step = Step(action, pose, similarity=similarity)
+                if rivals is not None:
+                    step = rivals.step(step, localizer.similarities(vector, topo.embeddings))
+                steps.append(step)
                 if keep_frames:
                     frames.append(current.rgb)
-            verdict = step_verdict(steps[-1], b, localizer.epsilon)
+            if trace:  # on the goal or bumped: every stop rule has decided this segment
+                last = steps[-1]
+                verdict = "traced" if last.collided or reached(last.pose, b) else None
+            else:
+                verdict = step_verdict(steps[-1], b, localizer.epsilon)
         used += len(steps)
         segments.append((b, steps))
-        if verdict == REACHED:
+        if verdict == REACHED or trace:
             n += 1
             continue
         if verdict == "collision" and replan and used < budget:
@@ -413,25 +465,57 @@ def run_episode(
     # The paper's rule, a collision ends it: the first failure. Under --replan the steps
     # before the first bump are the paper run's own (same views, same actions), so its
     # paper-rule outcome is read off the same run.
-    paper = _ending(segments, *judge_episode(segments, localizer.epsilon, k_max=k_max), localizer)
+    epsilon = localizer.epsilon
+    paper = _ending(segments, *judge_episode(segments, epsilon, k_max=k_max), epsilon, k_max)
     ending = paper
     if replan:
         failed = len(segments) - 1
         last = ("success", -1) if verdict == REACHED else (verdict or "navigation", failed)
-        ending = _ending(segments, *last, localizer)
-    return EpisodeResult(episode, *ending, segments, frames, paper, replans, clock)
+        ending = _ending(segments, *last, epsilon, k_max)
+    return EpisodeResult(episode, *ending, segments, frames, paper, replans, clock, trace)
 
 
 def _ending(
-    segments: list[tuple[Pose, list[Step]]], outcome: str, failed: int, localizer: AnyLocalizer
+    segments: list[tuple[Pose, list[Step]]],
+    outcome: str,
+    failed: int,
+    epsilon: float,
+    k_max: int,
 ) -> tuple[str, int, str | None]:
-    """(outcome, failed segment, detail): a collision's cause or a localization failure's kind."""
+    """(outcome, failed segment, detail): a collision's cause or a localization failure's
+    kind, read off the step that decided the failed segment (a traced segment goes on
+    after it)."""
     detail = None
     if outcome in ("collision", "localization"):
         goal, steps = segments[failed]
-        last = steps[-1]
-        detail = last.cause if last.collided else localization_kind(last, goal, localizer.epsilon)
+        _, used = judge_segment(goal, steps, epsilon, k_max=k_max)
+        last = steps[used - 1]
+        detail = last.cause if last.collided else localization_kind(last, goal, epsilon)
     return outcome, failed, detail
+
+
+@dataclass(frozen=True)
+class _Rivals:
+    """A traced segment's rows of the map: its goal, its start, the plan's next sub-node."""
+
+    goal: int
+    start: int
+    next: int | None
+
+    def __init__(self, topo: TopoMap, start: Pose, goal: Pose, after: Pose | None) -> None:
+        object.__setattr__(self, "goal", topo.index(goal))
+        object.__setattr__(self, "start", topo.index(start))
+        object.__setattr__(self, "next", None if after is None else topo.index(after))
+
+    def step(self, step: Step, scores: np.ndarray) -> Step:
+        """``step`` with its rival evidence from ``scores``, S against every map row."""
+        others = np.delete(scores, self.goal)
+        return dataclasses.replace(
+            step,
+            start_similarity=float(scores[self.start]),
+            next_similarity=float("nan") if self.next is None else float(scores[self.next]),
+            other_similarity=float(others.max()) if len(others) else float("nan"),
+        )
 
 
 def _embed(localizer: AnyLocalizer, live: LiveRooms, view: Any) -> np.ndarray:

@@ -31,6 +31,7 @@ __all__ = [
     "RULES",
     "Z95",
     "case_rates",
+    "case_row",
     "epsilon_rows",
     "markdown",
     "rate_rows",
@@ -148,18 +149,20 @@ def rate_rows(
 ) -> list[list[str]]:
     """Table II rows (``split``: the failure kinds instead) of every run under ``rule``;
     each cell ``percent [95 % low, high]`` (clustered by room) for N, then A."""
-    rows = []
-    for run in results["runs"]:
-        t = case_rates(run["episodes"], rule)
-        if split:
-            cells = [_label(run)]
-            names = DETAILS
-        else:
-            cells = [_label(run), f"{t['N']['total']} / {t['A']['total']}"]
-            names = OUTCOMES
-        cells += [f"{_cell(t['N'], name)} / {_cell(t['A'], name)}" for name in names]
-        rows.append(cells)
-    return rows
+    return [
+        case_row(_label(run), case_rates(run["episodes"], rule), split=split)
+        for run in results["runs"]
+    ]
+
+
+def case_row(label: str, rates: dict[str, dict[str, Any]], *, split: bool = False) -> list[str]:
+    """One row of :data:`RATE_HEADER` (``split``: of :data:`SPLIT_HEADER`) from
+    :func:`case_rates`' ``rates``, under ``label``."""
+    if split:
+        cells, names = [label], DETAILS
+    else:
+        cells, names = [label, f"{rates['N']['total']} / {rates['A']['total']}"], OUTCOMES
+    return cells + [f"{_cell(rates['N'], name)} / {_cell(rates['A'], name)}" for name in names]
 
 
 def time_rows(results: dict[str, Any]) -> list[list[str]]:
