@@ -27,7 +27,7 @@ from seannet.navigation.benchmark import run_navigation
 from seannet.navigation.config import STOP_POLICY_VAL_EPISODES, NavigationTestConfig
 from seannet.navigation.stopping import KINDS, StopRule, choose_rule, judged
 from seannet.navigation.tables import INTERVAL, RATE_HEADER, SPLIT_HEADER, case_rates, case_row
-from seannet.provenance import append_provenance
+from seannet.provenance import append_provenance, stamp
 from sgdata.fileio import atomic_write_text
 
 __all__ = ["STOP_POLICY", "choose_and_test", "stop_policy_markdown"]
@@ -83,15 +83,16 @@ def choose_and_test(
             "test": {"paper": case_rates(run["episodes"]),
                      "chosen": case_rates(judged(run["episodes"], chosen, config.k_max))},
         })  # fmt: skip
+    out.mkdir(parents=True, exist_ok=True)
+    made = append_provenance(out, ds, step="stop_policy")
     result = {
+        "made": stamp([made]),
         "navigator": test["navigator"],
         "dataset": test["dataset"],
         "val": val_config.settings(),
         "test": config.replace(trace=True).settings(),
         "runs": entries,
     }
-    out.mkdir(parents=True, exist_ok=True)
-    append_provenance(out, ds, step="stop_policy")
     atomic_write_text(out / STOP_POLICY, json.dumps(result, indent=1))
     written = out / STOP_POLICY.replace(".json", ".md")
     atomic_write_text(written, stop_policy_markdown(result))
@@ -134,6 +135,8 @@ def stop_policy_markdown(result: dict[str, Any]) -> str:
     val, test = result["val"], result["test"]
     lines = [
         "# A stop rule chosen on val for navigation success",
+        "",
+        result["made"],
         "",
         f"Val: {val['episodes_per_case_and_room']} traced episodes per case and room of the "
         f"val rooms; test: {test['episodes_per_case_and_room']} per case and room of the test "
