@@ -91,6 +91,7 @@ CASES = ("N", "A")  # neighbour sub-nodes / arbitrary sub-nodes
 FAILURES = ("navigation", "localization", "collision")
 OUTCOMES = ("success", *FAILURES)
 REACHED = "reached"  # a segment's goal reached and stopped at
+TRACED = "traced"  # a traced segment's end: on its goal or bumped (every rule has decided)
 BLOCKED, NAVIGATOR_ERROR = "path blocked", "navigator error"  # why a collision happened
 CAUSES = (BLOCKED, NAVIGATOR_ERROR)
 FALSE_STOP, MISSED_GOAL = "false stop", "missed goal"  # the two localization failures
@@ -349,7 +350,7 @@ def sample_episode(
     for _ in range(tries if nodes else 0):
         start = nodes[int(rng.integers(len(nodes)))]
         if case == "N":
-            near = sorted(n for n in graph.neighbors(start) if live.reachable(n[0], n[1]))
+            near = sorted(n for n in graph.successors(start) if live.reachable(n[0], n[1]))
             if not near:
                 continue
             path = [start, near[int(rng.integers(len(near)))]]
@@ -415,7 +416,8 @@ def run_episode(
             pose = a
             current = clock.timed("render", live.view, *pose)
         goal_vector, goal_image = topo.embedding(b), topo.image(b)
-        rivals = _Rivals(topo, a, b, plan[n + 2] if n + 2 < len(plan) else None) if trace else None
+        after = plan[n + 2] if n + 2 < len(plan) else None
+        rows = _rival_rows(topo, a, b, after) if trace else None
         steps: list[Step] = []
         verdict = None
         while verdict is None and len(steps) < min(k_max, budget - used):
@@ -436,14 +438,14 @@ def run_episode(
                 vector = clock.timed("embed", _embed, localizer, live, current)
                 similarity = float(localizer.similarities(vector, goal_vector[None])[0])
                 step = Step(action, pose, similarity=similarity)
-                if rivals is not None:
-                    step = rivals.step(step, localizer.similarities(vector, topo.embeddings))
+                if rows is not None:
+                    step = _with_rivals(step, localizer.similarities(vector, topo.embeddings), rows)
                 steps.append(step)
                 if keep_frames:
                     frames.append(current.rgb)
             if trace:  # on the goal or bumped: every stop rule has decided this segment
                 last = steps[-1]
-                verdict = "traced" if last.collided or reached(last.pose, b) else None
+                verdict = TRACED if last.collided or reached(last.pose, b) else None
             else:
                 verdict = step_verdict(steps[-1], b, localizer.epsilon)
         used += len(steps)
@@ -494,28 +496,21 @@ def _ending(
     return outcome, failed, detail
 
 
-@dataclass(frozen=True)
-class _Rivals:
+def _rival_rows(topo: TopoMap, start: Pose, goal: Pose, after: Pose | None) -> tuple:
     """A traced segment's rows of the map: its goal, its start, the plan's next sub-node."""
+    return topo.index(goal), topo.index(start), None if after is None else topo.index(after)
 
-    goal: int
-    start: int
-    next: int | None
 
-    def __init__(self, topo: TopoMap, start: Pose, goal: Pose, after: Pose | None) -> None:
-        object.__setattr__(self, "goal", topo.index(goal))
-        object.__setattr__(self, "start", topo.index(start))
-        object.__setattr__(self, "next", None if after is None else topo.index(after))
-
-    def step(self, step: Step, scores: np.ndarray) -> Step:
-        """``step`` with its rival evidence from ``scores``, S against every map row."""
-        others = np.delete(scores, self.goal)
-        return dataclasses.replace(
-            step,
-            start_similarity=float(scores[self.start]),
-            next_similarity=float("nan") if self.next is None else float(scores[self.next]),
-            other_similarity=float(others.max()) if len(others) else float("nan"),
-        )
+def _with_rivals(step: Step, scores: np.ndarray, rows: tuple) -> Step:
+    """``step`` with its rival evidence from ``scores`` (S against every map row)."""
+    goal, start, after = rows
+    others = np.delete(scores, goal)
+    return dataclasses.replace(
+        step,
+        start_similarity=float(scores[start]),
+        next_similarity=float("nan") if after is None else float(scores[after]),
+        other_similarity=float(others.max()) if len(others) else float("nan"),
+    )
 
 
 def _embed(localizer: AnyLocalizer, live: LiveRooms, view: Any) -> np.ndarray:

@@ -4,11 +4,13 @@ A map covers one layout of one room. Its nodes are the cells of the layout's rea
 whose indices are multiples of ``spacing`` (1: every cell; the authors used 2); each node has
 four heading sub-nodes ``(i, j, h)``, each holding its observation id, its image and its
 vector by one localizer (a trained run or any method: what the method's similarity reads,
-boxes included for a method that scores them). Edges (networkx, undirected):
+boxes included for a method that scores them). Edges (networkx, directed):
 
 - **translation** between the same heading of two neighbouring nodes (``spacing`` cells apart
   along i or j, every cell on the way reachable), cost the Manhattan distance in cells;
-- **rotation** between headings 90 degrees apart inside a node, cost 1.
+  forward or sideways of the heading, never backward: the robot has no backward move, so a
+  sub-goal behind it is reached by turning first;
+- **rotation** between headings 90 degrees apart inside a node, cost 1, both ways.
 
 Every sub-node is rendered live from the room's scene files
 (:class:`seannet.data.live_views.LiveRooms`),
@@ -39,7 +41,7 @@ from seannet.data.opening import DataSource
 from seannet.errors import MapError
 from seannet.navigation.config import MAP_SPACING
 from seannet.navigation.localizer import AnyLocalizer
-from seannet.navigation.motion import HEADINGS
+from seannet.navigation.motion import HEADINGS, local_offset
 from sgdata.dataset import decode_image
 from sgdata.dataset.paths import obs_id
 from sgdata.dataset.rows import encode_image
@@ -108,7 +110,7 @@ class TopoMap:
     obs_ids: list[str]
     embeddings: np.ndarray  # (N, D) float32: the localizer's vectors (unit rows for cosine)
     images: list[bytes]  # encoded in the dataset's image format
-    _graph: nx.Graph | None = field(default=None, repr=False)
+    _graph: nx.DiGraph | None = field(default=None, repr=False)
     _index: dict[SubNode, int] | None = field(default=None, repr=False)
 
     @property
@@ -149,20 +151,23 @@ class TopoMap:
     def embedding(self, key: SubNode) -> np.ndarray:
         return self.embeddings[self.index(key)]
 
-    def graph(self) -> nx.Graph:
-        """Sub-node graph: translation and rotation edges with ``cost`` and ``kind``."""
+    def graph(self) -> nx.DiGraph:
+        """Sub-node graph: translation and rotation edges with ``cost`` and ``kind``;
+        directed, a translation never backward of its heading (see the module doc)."""
         if self._graph is None:
-            g = nx.Graph()
+            g = nx.DiGraph()
             g.add_nodes_from(self.sub_nodes())
             for i, j in sorted({(a, b) for a, b, _ in self.sub_nodes()}):
                 for h in range(HEADINGS):
-                    g.add_edge(
-                        (i, j, h), (i, j, (h + 1) % HEADINGS), cost=ROTATION_COST, kind="rotation"
-                    )
+                    turn = ((i, j, h), (i, j, (h + 1) % HEADINGS))
+                    g.add_edge(*turn, cost=ROTATION_COST, kind="rotation")
+                    g.add_edge(*turn[::-1], cost=ROTATION_COST, kind="rotation")
             for i1, j1, i2, j2 in self.meta["edges"]:
+                cost = abs(i2 - i1) + abs(j2 - j1)
                 for h in range(HEADINGS):
-                    cost = abs(i2 - i1) + abs(j2 - j1)
-                    g.add_edge((i1, j1, h), (i2, j2, h), cost=cost, kind="translation")
+                    for a, b in (((i1, j1), (i2, j2)), ((i2, j2), (i1, j1))):
+                        if local_offset((*a, h), b)[0] >= 0:  # ahead or sideways
+                            g.add_edge((*a, h), (*b, h), cost=cost, kind="translation")
             self._graph = g
         return self._graph
 
@@ -187,7 +192,7 @@ class TopoMap:
         cut = [
             ((*a, h), (*b, h))
             for pair in avoid
-            for a, b in [sorted(pair)]
+            for a, b in (sorted(pair), sorted(pair)[::-1])
             for h in range(HEADINGS)
             if graph.has_edge((*a, h), (*b, h))
         ]

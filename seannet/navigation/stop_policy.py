@@ -105,8 +105,7 @@ def _pct(share: float) -> str:
 
 
 def _curve(choice: dict[str, Any]) -> list[list[str]]:
-    """The val success of the chosen rule's kind, margin and window at every epsilon tried,
-    and the best rule of every kind."""
+    """The val success of the chosen rule's kind, margin and window at every epsilon tried."""
     chosen = choice["chosen"]
     rows = []
     for row in choice["grid"]:
@@ -120,6 +119,7 @@ def _curve(choice: dict[str, Any]) -> list[list[str]]:
 
 
 def _best_per_kind(choice: dict[str, Any]) -> list[list[str]]:
+    """The best rule of every kind on val, with its success."""
     rows = []
     for kind in KINDS:
         mine = [row for row in choice["grid"] if row["rule"]["kind"] == kind]

@@ -48,8 +48,8 @@ __all__ = [
 KINDS = ("paper", "local", "map")
 # the grid a rule is chosen from: epsilon as offsets from the localizer's eval epsilon (its
 # own first, so a tie keeps it), margins of the relative rules, windows of views
-OFFSETS = (0.0, 0.05, -0.05, -0.1, -0.15, -0.2, -0.3, -0.4, -0.6)
-MARGINS = (0.0, -0.05, 0.02, 0.05, 0.1)
+OFFSETS = (0.0, 0.05, -0.05, -0.1, -0.15, -0.2, -0.3, -0.4, -0.6, -0.8, -1.0)
+MARGINS = (0.0, -0.05, 0.02, 0.05, 0.1, 0.15, 0.2, 0.3)
 WINDOWS = (1, 2)
 
 # a traced step's evidence (EpisodeResult.evidence): its fields' positions

@@ -24,6 +24,7 @@ from seannet.navigation.maps import (
     save_map,
     translation_edges,
 )
+from seannet.navigation.motion import HEADINGS, local_offset
 from sgdata.dataset import Dataset
 from sgdata.world.poses import pose_grid
 
@@ -76,7 +77,12 @@ def test_map_of_the_tiny_room_and_its_shortest_paths(tiny_room, tmp_path: Path) 
     assert nodes and all(grid.reachable[i, j] and i % 2 == 0 == j % 2 for i, j in nodes)
     g = topo.graph()
     assert g.number_of_nodes() == 4 * len(nodes)
-    assert g.number_of_edges() == 4 * len(nodes) + 4 * len(topo.meta["edges"])
+    # directed: a turn both ways (8 per cell); a move along its heading one way only (the
+    # robot has no backward move), sideways both ways: 6 per map edge
+    assert g.number_of_edges() == 8 * len(nodes) + 6 * len(topo.meta["edges"])
+    for a, b, kind in g.edges(data="kind"):
+        if kind == "translation":
+            assert local_offset(a, b[:2])[0] >= 0, (a, b)  # never backward
     i1, j1, i2, j2 = topo.meta["edges"][0]
     # an about-turn is two rotations; a move keeps the heading and costs its Manhattan length
     assert topo.shortest_path((i1, j1, 0), (i1, j1, 2)) in (
@@ -84,6 +90,13 @@ def test_map_of_the_tiny_room_and_its_shortest_paths(tiny_room, tmp_path: Path) 
         [(i1, j1, 0), (i1, j1, 3), (i1, j1, 2)],
     )
     assert topo.shortest_path((i1, j1, 1), (i2, j2, 1)) == [(i1, j1, 1), (i2, j2, 1)]
+    # a sub-goal behind the robot is reached by turning first
+    h = next(h for h in range(HEADINGS) if local_offset((i2, j2, h), (i1, j1))[0] < 0)
+    assert not g.has_edge((i2, j2, h), (i1, j1, h))
+    path = topo.shortest_path((i2, j2, h), (i1, j1, h))
+    # a quarter turn, a sidestep, a quarter turn back (cheaper than about-turns)
+    assert [p[:2] for p in path] == [(i2, j2)] * 2 + [(i1, j1)] * 2
+    assert all(g.has_edge(a, b) for a, b in zip(path, path[1:], strict=False))
     assert g.edges[(i1, j1, 1), (i2, j2, 1)]["cost"] == 2
     far = max(topo.sub_nodes(), key=lambda k: abs(k[0] - i1) + abs(k[1] - j1))
     path = topo.shortest_path((i1, j1, far[2]), far)
