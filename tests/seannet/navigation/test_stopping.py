@@ -88,7 +88,7 @@ def stop_policy_run(localizer_run: Path, mini_dataset: Path, tmp_path_factory) -
     out = tmp_path_factory.mktemp("stop_policy")
     done = run_cli(
         "seannet", "navigate", localizer_run, "--data", mini_dataset, "--oracle",
-        "--stop-policy", "--val-episodes", "3", "--episodes", "2", "--epsilon", "0.95",
+        "--stop-policy", "--val-episodes", "2", "--episodes", "2", "--epsilon", "0.95",
         "--out", out,
     )  # fmt: skip
     assert done.returncode == 0, done.stderr
@@ -126,7 +126,7 @@ def test_the_stop_policy_is_chosen_on_val_episodes_only(
     val = json.loads((stop_policy_run / "val" / "navigate_val.json").read_text())
     episodes = val["runs"][0]["episodes"]
     assert {e["room_id"] for e in episodes} <= set(_rooms(mini_dataset, "val"))
-    assert len(episodes) == 2 * 3 and all("evidence" in e for e in episodes)
+    assert len(episodes) == 2 * 2 and all("evidence" in e for e in episodes)
     assert choose_rule(episodes, 0.95) == a["choice"]
     test = json.loads((stop_policy_run / "test" / "navigate_test.json").read_text())
     assert {e["room_id"] for e in test["runs"][0]["episodes"]} <= set(_rooms(mini_dataset, "test"))
