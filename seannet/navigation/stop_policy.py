@@ -63,6 +63,8 @@ def choose_and_test(
         )
     if config.replan:
         raise NavigationError("--stop-policy judges episodes under the paper's rule: no --replan")
+    if val_episodes < 1:
+        raise NavigationError(f"--val-episodes {val_episodes}: expected >= 1 per case and room")
     ds = open_dataset(data)
     maps = out / "maps"
     val_config = config.replace(split="val", episodes=val_episodes, trace=True)

@@ -141,6 +141,9 @@ def test_the_stop_policy_is_refused_on_the_val_split_or_with_strips(
     with pytest.raises(NavigationError, match="--split val given"):
         choose_and_test([localizer_run], None, mini_dataset, tmp_path,
                         NavigationTestConfig(split="val"), epsilon=0.95)  # fmt: skip
+    with pytest.raises(NavigationError, match="--val-episodes 0"):
+        choose_and_test([localizer_run], None, mini_dataset, tmp_path, epsilon=0.95,
+                        val_episodes=0)  # fmt: skip
     refused = run_cli(
         "seannet", "navigate", localizer_run, "--data", mini_dataset, "--oracle",
         "--stop-policy", "--strips", tmp_path / "s", "--out", tmp_path,
