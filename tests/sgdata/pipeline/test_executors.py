@@ -45,7 +45,8 @@ def test_hash_seed_and_one_worker_give_the_same_bytes(
     assert digest_tree(root) == digest_tree(mini_dataset)
 
 
-@pytest.mark.slow  # starts a real local Ray cluster (about 40 s of its start-up) and generates
+# a real local Ray instance: 10 s alone, 87 s beside two busy workers (its start-up collapses)
+@pytest.mark.quiet
 def test_ray_executor_gives_the_same_bytes(
     tmp_path: Path, mini_dataset: Path, mini_config_file: Path
 ) -> None:

@@ -122,8 +122,9 @@ def test_resume_with_another_config_is_refused(tmp_path: Path, mini_config_file:
 
 @pytest.mark.parametrize(
     "executor",
-    # ray: a local Ray instance started, killed with the run and started again for the resume
-    ["local", pytest.param("ray", marks=pytest.mark.slow)],
+    # ray: a local Ray instance started, killed with the run and started again for the resume;
+    # quiet, as Ray's start-up beside two busy workers takes 2-8 times as long
+    ["local", pytest.param("ray", marks=pytest.mark.quiet)],
 )
 def test_sigkill_mid_run_then_resume(
     tmp_path: Path,
