@@ -435,6 +435,15 @@ def navigate(
     val_episodes: Annotated[
         int, typer.Option(help="--stop-policy: val episodes per case and room to choose on.")
     ] = STOP_POLICY_VAL_EPISODES,
+    map_memory: Annotated[
+        str,
+        typer.Option(
+            "--map-memory",
+            help="--stop-policy, beyond the paper: also run the test stopped by the chosen "
+            "rule on a map that learns the layout it is in: off, episode (for the rest of an "
+            "episode) or layout (for the later episodes in the same layout too).",
+        ),
+    ] = "off",
 ) -> None:
     """The navigation test (paper Table II): success and failure rates, N / A, per localizer.
     Resumes where a killed run stopped."""
@@ -449,8 +458,12 @@ def navigate(
     )
     if stop_policy:
         _navigate_stop_policy(runs, navigator, data, config, val_episodes, workers, out,
-                              epsilon=epsilon, strips=strips)  # fmt: skip
+                              epsilon=epsilon, strips=strips, map_memory=map_memory)  # fmt: skip
         return
+    if map_memory != "off":
+        raise NavigationError(
+            f"--map-memory {map_memory} is for --stop-policy: the paper's rule keeps its map"
+        )
     with console.status("navigate") as status:
         result = run_navigation(
             runs, navigator, data, config, epsilon=epsilon, workers=workers, out=out, maps=maps,
@@ -477,6 +490,7 @@ def _navigate_stop_policy(
     *,
     epsilon: float | None,
     strips: Path | None,
+    map_memory: str,
 ) -> None:
     """``seannet navigate --stop-policy``: the choice on val, the test rows, the markdown."""
     from seannet.errors import NavigationError
@@ -490,7 +504,7 @@ def _navigate_stop_policy(
     with console.status("navigate --stop-policy") as status:
         result = choose_and_test(runs, navigator, data, where, config, epsilon=epsilon,
                                  workers=workers, val_episodes=val_episodes,
-                                 progress=status.update)  # fmt: skip
+                                 map_memory=map_memory, progress=status.update)  # fmt: skip
     typer.echo(Path(result["written"]).read_text())
     console.print(f"wrote {result['written']} and its .json")
 

@@ -52,6 +52,7 @@ from seannet.navigation.maps import (
     save_map,
 )
 from seannet.navigation.navigator import load_navigator, resize
+from seannet.navigation.stopping import StopRule
 from seannet.navigation.tables import markdown, write_results
 from seannet.provenance import append_provenance
 from seannet.seeds import episode_seed
@@ -87,6 +88,7 @@ def run_navigation(
     out: Path | None = None,
     maps: Path | None = None,
     strips: Path | None = None,
+    stop_rules: dict[Path | str, StopRule] | None = None,
     progress: Callable[[str], None] | None = None,
 ) -> dict[str, Any]:
     """Run the navigation test of every localizer run on the rooms of ``config.split``.
@@ -100,6 +102,9 @@ def run_navigation(
         workers: processes running maps and episodes in parallel.
         epsilon: one threshold for every run, or per run ``(epsilon, where it comes from)``
             (a run left out reads its eval files); None: each run's eval files.
+        stop_rules: beyond the paper, per run the rule its live episodes stop by instead of
+            the paper's (its ending is read as the paper row's); with ``config.map_memory``
+            the map learns the layout (:func:`seannet.navigation.episodes.run_episode`).
 
     Writes ``navigate_<split>.json`` and ``.md`` into ``out`` (default: the navigator run),
     maps under ``maps`` (default: ``out/maps``), and under ``strips`` when given, per run,
@@ -110,11 +115,13 @@ def run_navigation(
         CheckpointError: a run or the navigator was trained on another dataset.
         MethodError: a method that cannot be opened or breaks a check.
         NavigationError: bad counts, no epsilon for a run, a split without rooms, a room
-            without an episode, or no ``out`` for the oracle.
+            without an episode, no ``out`` for the oracle, stop rules not one per run or
+            with ``trace`` or ``replan``, a map memory without them.
     """
     config = config if config is not None else NavigationTestConfig()
     if workers < 1:
         raise NavigationError(f"--workers {workers}: expected >= 1")
+    _check_stop_rules(runs, stop_rules, config)
     out = out if out is not None else navigator
     if out is None:
         raise NavigationError("the oracle navigator has no run directory: pass --out")
@@ -139,8 +146,11 @@ def run_navigation(
     labels = dict(zip(runs, run_labels(runs), strict=True))
     named = dict(zip(runs, localizers, strict=True))
     _build_maps(named, ds.root, rooms, {r: maps / labels[r] for r in runs}, config, workers, say)
+    rules = stop_rules or {}
     jobs = {
-        (run, room_id, case): _job(settings, run, loc, labels[run], room_id, case, maps, strips)
+        (run, room_id, case): _job(
+            settings, run, loc, labels[run], room_id, case, maps, strips, rules.get(run)
+        )
         for run, loc in named.items()
         for room_id in rooms
         for case in CASES
@@ -154,7 +164,7 @@ def run_navigation(
             episode for room_id in rooms for case in CASES
             for episode in _finished_part(jobs[run, room_id, case], out)
         ]  # fmt: skip
-        results["runs"].append(_run_entry(run, loc, labels[run], records))
+        results["runs"].append(_run_entry(run, loc, labels[run], records, rules.get(run)))
     out.mkdir(parents=True, exist_ok=True)
     append_provenance(out, ds, step=results_path(out, config.split).stem)
     write_results(results, results_path(out, config.split))
@@ -198,10 +208,12 @@ def _job(
     case: str,
     maps: Path,
     strips: Path | None,
+    rule: StopRule | None,
 ) -> dict[str, Any]:
     """One task: the episodes of one (run, room, case); its key fields say what they depend on."""
     return {
         **settings,
+        **({"stop_rule": dataclasses.asdict(rule)} if rule is not None else {}),
         "run": str(run),
         "checkpoint_sha256": loc.digest,
         "epsilon": loc.epsilon,
@@ -214,18 +226,41 @@ def _job(
 
 
 def _run_entry(
-    run: Path | str, loc: AnyLocalizer, label: str, records: list[dict[str, Any]]
+    run: Path | str,
+    loc: AnyLocalizer,
+    label: str,
+    records: list[dict[str, Any]],
+    rule: StopRule | None,
 ) -> dict[str, Any]:
-    """A run's entry of the results: what it is, its threshold, its episodes."""
+    """A run's entry of the results: what it is, its threshold (or stop rule), its episodes."""
     return {
         "run": str(run),
         "label": label,
         "model": loc.name,
         "epsilon": loc.epsilon,
         "epsilon_source": loc.epsilon_source,
+        **({"stop_rule": dataclasses.asdict(rule)} if rule is not None else {}),
         "checkpoint_sha256": loc.digest,
         "episodes": records,
     }
+
+
+def _check_stop_rules(
+    runs: list[Path | str],
+    stop_rules: dict[Path | str, StopRule] | None,
+    config: NavigationTestConfig,
+) -> None:
+    if stop_rules is None:
+        if config.map_memory != "off":
+            raise NavigationError(
+                f"--map-memory {config.map_memory}: the map learns its layout under a chosen "
+                "stop rule only (--stop-policy); the paper's rule keeps the map it was given"
+            )
+        return
+    if set(stop_rules) != set(runs):
+        raise NavigationError("stop rules: expected one for each localizer run")
+    if config.trace or config.replan:
+        raise NavigationError("episodes stopped by a chosen rule are neither traced nor replanned")
 
 
 def _finished_part(job: dict[str, Any], out: Path) -> list[dict[str, Any]]:
@@ -298,11 +333,12 @@ def run_labels(runs: list[Path | str]) -> list[str]:
 _KEY_FIELDS = (
     "split", "episodes_per_case_and_room", "seed", "k_max", "spacing", "replan", "trace",
     "navigator_sha256", "dataset", "run", "checkpoint_sha256", "epsilon", "room_id", "case",
+    "stop_rule", "map_memory",
 )  # fmt: skip
 
 
 def _key(job: dict[str, Any]) -> dict[str, Any]:
-    return {k: job[k] for k in _KEY_FIELDS}
+    return {k: job[k] for k in _KEY_FIELDS if k in job}  # settings name some only when set
 
 
 def _part_path(job: dict[str, Any], out: Path) -> Path:
@@ -349,17 +385,26 @@ def _case_task(job: dict[str, Any], data: str, out: str) -> dict:
     topo = load_map(directory)
     check_map(topo, localizer, directory)
     room_id, case = job["room_id"], job["case"]
+    rule = StopRule(**job["stop_rule"]) if "stop_rule" in job else None
+    scope = job.get("map_memory", "off")
+    learned: dict[int, np.ndarray] = {}  # map_memory "layout": the map as each layout taught it
     records = []
     drawn: set[str] = set()  # the outcome kinds drawn as strips already
     with LiveRooms(ds) as live:
         for index in range(job["episodes_per_case_and_room"]):
             rng = rng_for(episode_seed(job["seed"], room_id, case, index))
             episode = sample_episode(topo, live, case, rng, index=index)
+            memory = None
+            if scope == "episode":
+                memory = topo.embeddings.copy()
+            elif scope == "layout":
+                memory = learned.setdefault(episode.layout, topo.embeddings.copy())
             keep = job["strips"] is not None
             started = time.perf_counter()
             result = run_episode(
                 episode, topo, live, localizer, policy,
                 k_max=job["k_max"], replan=job["replan"], keep_frames=keep, trace=job["trace"],
+                rule=rule, memory=memory,
             )  # fmt: skip
             record = result.to_dict()
             record["seconds"]["total"] = time.perf_counter() - started

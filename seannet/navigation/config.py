@@ -17,6 +17,7 @@ from seannet.weights import IMAGE_ENCODERS
 __all__ = [
     "FUSIONS",
     "K_MAX",
+    "MAP_MEMORY",
     "MAP_SPACING",
     "RULES",
     "STOP_POLICY_VAL_EPISODES",
@@ -33,6 +34,10 @@ RULES = ("paper", "replan")
 # val episodes per case and room a stop policy is chosen on (seannet navigate --stop-policy):
 # 400 per case on medium's 8 val rooms
 STOP_POLICY_VAL_EPISODES = 50
+# beyond the paper, a map that learns the layout it is in: a sub-node's stored embedding is
+# replaced by the current view's when a stop rule stops on it, for the rest of the episode or
+# for every later episode of the task in the same layout (NavigationTestConfig.map_memory)
+MAP_MEMORY = ("off", "episode", "layout")
 
 
 @dataclass(frozen=True)
@@ -110,6 +115,8 @@ class NavigationTestConfig:
     # trace every segment for stop rules judged offline (seannet.navigation.stopping); its
     # paper-rule outcome is the one a plain run has
     trace: bool = False
+    # MAP_MEMORY: with chosen stop rules only (run_navigation's stop_rules)
+    map_memory: str = "off"
 
     def __post_init__(self) -> None:
         if self.episodes < 1:
@@ -120,6 +127,10 @@ class NavigationTestConfig:
             raise NavigationError(f"--spacing {self.spacing}: expected >= 1 cell")
         if self.trace and self.replan:
             raise NavigationError("a traced test is judged under the paper's rule: no --replan")
+        if self.map_memory not in MAP_MEMORY:
+            raise NavigationError(
+                f"--map-memory {self.map_memory}: expected one of {', '.join(MAP_MEMORY)}"
+            )
 
     @property
     def rules(self) -> tuple[str, ...]:
@@ -140,6 +151,8 @@ class NavigationTestConfig:
             "spacing": self.spacing,
             "replan": self.replan,
             "trace": self.trace,
+            # beyond the paper: named only when set, so older results keep their keys
+            **({"map_memory": self.map_memory} if self.map_memory != "off" else {}),
         }
 
     @classmethod
@@ -153,4 +166,5 @@ class NavigationTestConfig:
             spacing=results["spacing"],
             replan=bool(results.get("replan", False)),
             trace=bool(results.get("trace", False)),
+            map_memory=results.get("map_memory", "off"),
         )

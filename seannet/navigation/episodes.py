@@ -26,6 +26,12 @@ sub-nodes; the next segment starts on its start sub-node. The navigator's action
 depend on S, and a segment that ends well ends on its goal's pose, so any stop rule judged on
 the trace gives the outcome a run under that rule would have had; the paper's rule included.
 
+Beyond the paper (``rule``): a live run may stop by a chosen stop rule
+(:class:`seannet.navigation.stopping.StopRule`) on the same evidence a trace records, and its
+map may learn the layout it is in (``memory``): when the rule stops on a goal, that sub-node's
+stored embedding becomes the current view's, so what comes later compares against today's
+arrangement (the navigator's goal image stays the map's).
+
 Beyond the paper (``replan``): a real robot feels a bump. A collision then marks the
 segment's map edge unusable for the episode, the robot localizes itself on the map with the
 localizer (its best sub-node) and Dijkstra plans again from there; the episode ends on any
@@ -72,6 +78,7 @@ __all__ = [
     "Step",
     "Timing",
     "collision_cause",
+    "evidence_row",
     "free_path_steps",
     "ideal_action",
     "judge_episode",
@@ -95,6 +102,7 @@ TRACED = "traced"  # a traced segment's end: on its goal or bumped (every rule h
 BLOCKED, NAVIGATOR_ERROR = "path blocked", "navigator error"  # why a collision happened
 CAUSES = (BLOCKED, NAVIGATOR_ERROR)
 FALSE_STOP, MISSED_GOAL = "false stop", "missed goal"  # the two localization failures
+_FALSE_STOPPED = ("localization", FALSE_STOP)  # a stop rule's verdict on a stop off the goal
 LOCALIZATION_KINDS = (FALSE_STOP, MISSED_GOAL)
 # --replan: the episode's steps may reach this many times the paper's most (k_max per
 # segment of the first plan), so detours are possible but a robot bumping in circles stops
@@ -311,16 +319,18 @@ class EpisodeResult:
         """Per segment, per step: ``[S goal, S start, S next, S other, on the goal, collision
         cause]`` (a NaN as None; the cause "" when the step did not collide), what a stop rule
         is judged on (:mod:`seannet.navigation.stopping`)."""
+        return [[evidence_row(s, goal) for s in steps] for goal, steps in self.segments]
 
-        def number(value: float) -> float | None:
-            return None if math.isnan(value) else float(value)
 
-        return [
-            [[number(s.similarity), number(s.start_similarity), number(s.next_similarity),
-              number(s.other_similarity), reached(s.pose, goal) and not s.collided,
-              s.cause or ""] for s in steps]
-            for goal, steps in self.segments
-        ]  # fmt: skip
+def evidence_row(step: Step, goal: Pose) -> list[Any]:
+    """``step``'s evidence as a stop rule reads it (:meth:`EpisodeResult.evidence`)."""
+
+    def number(value: float) -> float | None:
+        return None if math.isnan(value) else float(value)
+
+    return [number(step.similarity), number(step.start_similarity),
+            number(step.next_similarity), number(step.other_similarity),
+            reached(step.pose, goal) and not step.collided, step.cause or ""]  # fmt: skip
 
 
 def sample_episode(
@@ -377,6 +387,8 @@ def run_episode(
     replan: bool = False,
     keep_frames: bool = False,
     trace: bool = False,
+    rule: Any = None,
+    memory: np.ndarray | None = None,
 ) -> EpisodeResult:
     """Run ``episode`` on the live renderer (see the module doc).
 
@@ -388,13 +400,24 @@ def run_episode(
         keep_frames: keep every view (for strips).
         trace: never stop on S; record every segment's evidence (see the module doc). Its
             outcome is the paper rule's, judged on the trace.
+        rule: stop by this :class:`~seannet.navigation.stopping.StopRule` instead of the
+            paper's; its ending is the result's and its paper field's.
+        memory: the map's embeddings as this run knows them (a copy of
+            ``topo.embeddings``), with ``rule`` only: a stop on a goal writes the current
+            view's embedding into the goal's row, in place.
 
     Raises:
         NavigationError: ``trace`` with ``replan`` (a trace is judged under the paper's
-            collision rule).
+            collision rule), ``rule`` with either, ``memory`` without ``rule``.
     """
     if trace and replan:
         raise NavigationError("a traced episode is judged under the paper's rule: no replan")
+    if rule is not None and (trace or replan):
+        raise NavigationError("an episode stopped by a chosen rule is neither traced nor replanned")
+    if memory is not None and rule is None:
+        raise NavigationError("the map learns its layout under a chosen stop rule only")
+    stored = topo.embeddings if memory is None else memory
+    ended: tuple[str, int, str | None] | None = None  # under rule: how the episode ended
     live.load(episode.room_id, episode.layout)
     clock = Timing()
     pose = episode.path[0]
@@ -415,9 +438,9 @@ def run_episode(
         if trace and pose != a:  # every traced segment starts on its start sub-node
             pose = a
             current = clock.timed("render", live.view, *pose)
-        goal_vector, goal_image = topo.embedding(b), topo.image(b)
+        goal_vector, goal_image = stored[topo.index(b)], topo.image(b)
         after = plan[n + 2] if n + 2 < len(plan) else None
-        rows = _rival_rows(topo, a, b, after) if trace else None
+        rows = _rival_rows(topo, a, b, after) if trace or rule is not None else None
         steps: list[Step] = []
         verdict = None
         while verdict is None and len(steps) < min(k_max, budget - used):
@@ -439,17 +462,26 @@ def run_episode(
                 similarity = float(localizer.similarities(vector, goal_vector[None])[0])
                 step = Step(action, pose, similarity=similarity)
                 if rows is not None:
-                    step = _with_rivals(step, localizer.similarities(vector, topo.embeddings), rows)
+                    step = _with_rivals(step, localizer.similarities(vector, stored), rows)
                 steps.append(step)
                 if keep_frames:
                     frames.append(current.rgb)
             if trace:  # on the goal or bumped: every stop rule has decided this segment
                 last = steps[-1]
                 verdict = TRACED if last.collided or reached(last.pose, b) else None
+            elif rule is not None:
+                decided = rule.verdict([evidence_row(s, b) for s in steps])
+                verdict = None if decided is None else decided[0]
+                if decided is not None and decided[0] != REACHED:
+                    ended = (decided[0], n, decided[1])
+                if memory is not None and (verdict == REACHED or decided == _FALSE_STOPPED):
+                    memory[topo.index(b)] = vector  # it stopped: it believes it stands on b
             else:
                 verdict = step_verdict(steps[-1], b, localizer.epsilon)
         used += len(steps)
         segments.append((b, steps))
+        if rule is not None and verdict is None:  # k_max steps decided nothing
+            ended = ("navigation", n, None)
         if verdict == REACHED or trace:
             n += 1
             continue
@@ -467,6 +499,9 @@ def run_episode(
     # The paper's rule, a collision ends it: the first failure. Under --replan the steps
     # before the first bump are the paper run's own (same views, same actions), so its
     # paper-rule outcome is read off the same run.
+    if rule is not None:
+        ending = ended or ("success", -1, None)
+        return EpisodeResult(episode, *ending, segments, frames, ending, 0, clock)
     epsilon = localizer.epsilon
     paper = _ending(segments, *judge_episode(segments, epsilon, k_max=k_max), epsilon, k_max)
     ending = paper

@@ -6,6 +6,8 @@ navigation success, then the test episodes judged once by it and by the paper's 
    on the same traces, and the best mean success over N and A is kept.
 2. Traced episodes on the test rooms, read once: the paper's rule at the localizer's eval
    epsilon (its own row, as the paper has it) and the chosen rule, on the same episodes.
+3. With a ``map_memory``, beyond the paper: the same test episodes run live, stopped by the
+   chosen rule, on a map that learns the layout it is in (its own row).
 
 Both runs are :func:`~seannet.navigation.benchmark.run_navigation`'s (workers, resumable
 parts, maps shared) under ``out/val`` and ``out/test``; ``stop_policy.json`` and ``.md``
@@ -44,13 +46,15 @@ def choose_and_test(
     *,
     epsilon: float | dict[Path, tuple[float, str]] | None = None,
     val_episodes: int = STOP_POLICY_VAL_EPISODES,
+    map_memory: str = "off",
     workers: int = 1,
     progress: Callable[[str], None] | None = None,
 ) -> dict[str, Any]:
     """Choose each localizer's stop rule on val, then judge the test episodes once by it and
     by the paper's rule (see the module doc); writes ``out/stop_policy.json`` and ``.md``.
     ``epsilon`` as :func:`run_navigation` takes it (None: each run's eval epsilon): the paper
-    row's threshold and the centre of the grid the rule is chosen from.
+    row's threshold and the centre of the grid the rule is chosen from. ``map_memory``
+    (:data:`~seannet.navigation.config.MAP_MEMORY`): off, or the third row's scope.
 
     Raises:
         NavigationError: ``config`` is not of the test split, or asks for ``replan``; what
@@ -65,6 +69,7 @@ def choose_and_test(
         raise NavigationError("--stop-policy judges episodes under the paper's rule: no --replan")
     if val_episodes < 1:
         raise NavigationError(f"--val-episodes {val_episodes}: expected >= 1 per case and room")
+    live_config = config.replace(map_memory=map_memory)  # checked before any episode runs
     ds = open_dataset(data)
     maps = out / "maps"
     val_config = config.replace(split="val", episodes=val_episodes, trace=True)
@@ -75,15 +80,23 @@ def choose_and_test(
     test = run_navigation(runs, navigator, ds, config.replace(trace=True), epsilon=epsilon,
                           workers=workers, out=out / "test", maps=maps,
                           progress=progress)  # fmt: skip
+    rules = {run: StopRule(**choice["chosen"]) for run, choice in zip(runs, choices, strict=True)}
+    learned = [None] * len(runs)
+    if map_memory != "off":
+        live = run_navigation(runs, navigator, ds, live_config,
+                              epsilon=epsilon, workers=workers, out=out / "memory", maps=maps,
+                              stop_rules=rules, progress=progress)  # fmt: skip
+        learned = [case_rates(run["episodes"]) for run in live["runs"]]
     entries = []
-    for run, choice in zip(test["runs"], choices, strict=True):
-        chosen = StopRule(**choice["chosen"])
+    for run, choice, rule, memory in zip(test["runs"], choices, rules.values(), learned,
+                                         strict=True):  # fmt: skip
         entries.append({
             "run": run["run"], "label": run["label"], "model": run["model"],
             "epsilon": run["epsilon"], "epsilon_source": run["epsilon_source"],
             "choice": choice,
             "test": {"paper": case_rates(run["episodes"]),
-                     "chosen": case_rates(judged(run["episodes"], chosen, config.k_max))},
+                     "chosen": case_rates(judged(run["episodes"], rule, config.k_max)),
+                     **({"memory": memory} if memory is not None else {})},
         })  # fmt: skip
     out.mkdir(parents=True, exist_ok=True)
     made = append_provenance(out, ds, step="stop_policy")
@@ -93,6 +106,7 @@ def choose_and_test(
         "dataset": test["dataset"],
         "val": val_config.settings(),
         "test": config.replace(trace=True).settings(),
+        "map_memory": map_memory,
         "runs": entries,
     }
     atomic_write_text(out / STOP_POLICY, json.dumps(result, indent=1))
@@ -164,8 +178,12 @@ def stop_policy_markdown(result: dict[str, Any]) -> str:
             "",
             *table(["epsilon", "N", "A", "mean"], _curve(choice)),
         ]
-        for rule, rates in (("paper rule, eval epsilon", run["test"]["paper"]),
-                            (f"chosen: {choice['label']}", run["test"]["chosen"])):  # fmt: skip
+        tested = [("paper rule, eval epsilon", run["test"]["paper"]),
+                  (f"chosen: {choice['label']}", run["test"]["chosen"])]  # fmt: skip
+        if "memory" in run["test"]:
+            tested.append((f"chosen, map memory {result['map_memory']} (beyond the paper)",
+                           run["test"]["memory"]))  # fmt: skip
+        for rule, rates in tested:
             rows.append(case_row(f"{name}, {rule}", rates))
             splits.append(case_row(f"{name}, {rule}", rates, split=True))
     lines += [

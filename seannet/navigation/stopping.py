@@ -96,6 +96,18 @@ class StopRule:
         rival = _mean(rivals)
         return math.isnan(rival) or goal - rival > self.margin
 
+    def verdict(self, history: Sequence[Sequence[Any]]) -> tuple[str, str | None] | None:
+        """What the last of ``history`` (a segment's evidence rows so far) decides under this
+        rule: ``(REACHED, None)``, a failure ``(outcome, detail)``, or None (go on)."""
+        row = history[-1]
+        if row[_CAUSE]:
+            return "collision", row[_CAUSE]
+        if self.stops(history):
+            return (REACHED, None) if row[_ON_GOAL] else ("localization", FALSE_STOP)
+        if row[_ON_GOAL]:  # on the goal without stopping: the robot passes it
+            return "localization", MISSED_GOAL
+        return None
+
 
 def _mean(values: Sequence[float | None]) -> float:
     numbers = [v for v in values if v is not None and not math.isnan(v)]
@@ -115,15 +127,10 @@ def judge_traced(
     stopping decides it; ``k_max`` steps that decide nothing are a navigation failure."""
     for n, steps in enumerate(evidence):
         verdict: tuple[str, str | None] = ("navigation", None)
-        for k, row in enumerate(steps[:k_max]):
-            if row[_CAUSE]:
-                verdict = ("collision", row[_CAUSE])
-                break
-            if rule.stops(steps[: k + 1]):
-                verdict = (REACHED, None) if row[_ON_GOAL] else ("localization", FALSE_STOP)
-                break
-            if row[_ON_GOAL]:  # on the goal without stopping: the robot passes it
-                verdict = ("localization", MISSED_GOAL)
+        for k in range(min(len(steps), k_max)):
+            decided = rule.verdict(steps[: k + 1])
+            if decided is not None:
+                verdict = decided
                 break
         if verdict[0] != REACHED:
             return verdict[0], n, verdict[1]

@@ -194,8 +194,11 @@ def markdown(results: dict[str, Any]) -> str:
         f"navigator {results['navigator']}; N: neighbour sub-nodes, A: arbitrary sub-nodes. "
         f"Each cell: percent [{INTERVAL}], N / A.",
     ]
+    memory = results.get("map_memory", "off")
     titles = {
-        "paper": "The paper's rule (a collision ends the episode)",
+        "paper": "The paper's rule (a collision ends the episode)"
+        if not any("stop_rule" in run for run in results["runs"])
+        else f"Each run's chosen stop rule, map memory {memory} (beyond the paper)",
         "replan": "Bump and replan (beyond the paper)",
     }
     for rule in rules:

@@ -1,18 +1,27 @@
 """Stop rules (issue 48): judged on constructed traces, the paper's rule on a real trace
-agreeing with a plain run, and `seannet navigate --stop-policy` choosing on val only."""
+agreeing with a plain run, a live run under a rule agreeing with its trace, the map that
+learns its layout, and `seannet navigate --stop-policy` choosing on val only."""
 
 from __future__ import annotations
 
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
+from seannet.data.datasets import open_dataset
+from seannet.data.live_views import LiveRooms
 from seannet.errors import NavigationError
-from seannet.navigation.benchmark import run_navigation
+from seannet.navigation.benchmark import run_labels, run_navigation
 from seannet.navigation.config import NavigationTestConfig
+from seannet.navigation.episodes import run_episode, sample_episode
+from seannet.navigation.localizer import load_localizer
+from seannet.navigation.maps import load_map
 from seannet.navigation.stop_policy import choose_and_test
 from seannet.navigation.stopping import StopRule, candidates, choose_rule, judge_traced
+from seannet.seeds import episode_seed
+from sgdata.seeds import rng_for
 
 from ...cli_runner import run_cli
 
@@ -89,10 +98,11 @@ def stop_policy_run(localizer_run: Path, mini_dataset: Path, tmp_path_factory) -
     done = run_cli(
         "seannet", "navigate", localizer_run, "--data", mini_dataset, "--oracle",
         "--stop-policy", "--val-episodes", "2", "--episodes", "2", "--epsilon", "0.95",
-        "--out", out,
+        "--map-memory", "layout", "--out", out,
     )  # fmt: skip
     assert done.returncode == 0, done.stderr
     assert "# A stop rule chosen on val" in done.stdout
+    assert "map memory layout (beyond the paper)" in done.stdout
     return out
 
 
@@ -131,8 +141,64 @@ def test_the_stop_policy_is_chosen_on_val_episodes_only(
     test = json.loads((stop_policy_run / "test" / "navigate_test.json").read_text())
     assert {e["room_id"] for e in test["runs"][0]["episodes"]} <= set(_rooms(mini_dataset, "test"))
     assert a["test"]["paper"]["N"]["total"] == 2 == a["test"]["chosen"]["A"]["total"]
+    assert a["test"]["memory"]["A"]["total"] == 2  # the map that learns its layout, live
     written = (stop_policy_run / "stop_policy.md").read_text()
     assert f"**{a['choice']['label']}**" in written and "## Test (read once)" in written
+
+
+@pytest.mark.parametrize("rule", [StopRule("local", 0.5, 0.02), StopRule("map", 0.3, 0.05, 2)])
+def test_a_live_run_under_a_rule_ends_as_its_trace_is_judged(
+    rule: StopRule, stop_policy_run: Path, localizer_run: Path, mini_dataset: Path,
+    tmp_path: Path,
+) -> None:  # fmt: skip
+    traced = json.loads((stop_policy_run / "test" / "navigate_test.json").read_text())
+    live = run_navigation([localizer_run], None, mini_dataset, NavigationTestConfig(episodes=2),
+                          epsilon=0.95, out=tmp_path, maps=stop_policy_run / "maps",
+                          stop_rules={localizer_run: rule})  # fmt: skip
+    (run,) = live["runs"]
+    assert StopRule(**run["stop_rule"]) == rule
+    pairs = zip(run["episodes"], traced["runs"][0]["episodes"], strict=True)
+    for a, b in pairs:
+        assert a["path"] == b["path"]
+        ending = (a["paper"]["outcome"], a["paper"]["failed_segment"], a["paper"]["detail"])
+        assert ending == judge_traced(b["evidence"], rule)
+        assert a["outcome"] == a["paper"]["outcome"]
+    assert "chosen stop rule, map memory off" in Path(live["written"]).read_text()
+
+
+def test_the_map_learns_only_the_sub_nodes_it_stopped_on(
+    stop_policy_run: Path, localizer_run: Path, mini_dataset: Path
+) -> None:
+    localizer = load_localizer(localizer_run, mini_dataset, epsilon=0.95)
+    (room,) = open_dataset(mini_dataset).rooms("test")
+    (label,) = run_labels([localizer_run])
+    topo = load_map(stop_policy_run / "maps" / label / room)
+    given = topo.embeddings.copy()
+    rule = StopRule("paper", -1.0)  # S > -1 always: it stops on every step that does not bump
+    learned = 0
+    with LiveRooms(mini_dataset) as live:
+        for index in range(4):
+            rng = rng_for(episode_seed(0, room, "A", index))
+            episode = sample_episode(topo, live, "A", rng, index=index)
+            memory = topo.embeddings.copy()
+            result = run_episode(episode, topo, live, localizer, None, rule=rule, memory=memory)
+            stops = {topo.index(goal): steps[-1].pose for goal, steps in result.segments
+                     if not steps[-1].collided}  # fmt: skip
+            changed = {i for i in range(len(memory)) if not np.array_equal(memory[i], given[i])}
+            assert changed <= set(stops)
+            for row in changed:  # the view it stood in when it stopped
+                view = live.tensors(live.view(*stops[row]), localizer.transform)
+                np.testing.assert_allclose(memory[row], localizer.embed([view])[0], atol=1e-5)
+            learned += len(changed)
+        with pytest.raises(NavigationError, match="under a chosen stop rule only"):
+            run_episode(episode, topo, live, localizer, None, memory=topo.embeddings.copy())
+    assert learned > 0
+    np.testing.assert_array_equal(topo.embeddings, given)  # the map itself is never written
+    with pytest.raises(NavigationError, match="the paper's rule keeps the map"):
+        run_navigation([localizer_run], None, mini_dataset,
+                       NavigationTestConfig(episodes=2, map_memory="layout"), epsilon=0.95,
+                       out=stop_policy_run / "refused", maps=stop_policy_run / "maps")  # fmt: skip
+    assert not (stop_policy_run / "refused").exists()
 
 
 def test_the_stop_policy_is_refused_on_the_val_split_or_with_strips(
@@ -150,6 +216,12 @@ def test_the_stop_policy_is_refused_on_the_val_split_or_with_strips(
     )  # fmt: skip
     assert refused.returncode != 0 and "Traceback" not in refused.stderr
     assert "--strips" in refused.stderr.strip().splitlines()[-1]
+    refused = run_cli(
+        "seannet", "navigate", localizer_run, "--data", mini_dataset, "--oracle",
+        "--map-memory", "episode", "--out", tmp_path,
+    )  # fmt: skip
+    assert refused.returncode != 0 and "Traceback" not in refused.stderr
+    assert "--map-memory episode is for --stop-policy" in refused.stderr.strip().splitlines()[-1]
     assert not any(tmp_path.iterdir())
 
 
