@@ -9,10 +9,10 @@ navigation success, then the test episodes judged once by it and by the paper's 
 3. With a ``map_memory``, beyond the paper: the same test episodes run live, stopped by the
    chosen rule, on a map that learns the layout it is in (its own row).
 
-Both runs are :func:`~seannet.navigation.benchmark.run_navigation`'s (workers, resumable
-parts, maps shared) under ``out/val`` and ``out/test``; ``stop_policy.json`` and ``.md``
-hold the choice (with its val grid) and both test rows, with 95 % intervals clustered by
-room.
+Each run is :func:`~seannet.navigation.benchmark.run_navigation`'s (workers, resumable
+parts, maps shared) under ``out/val``, ``out/test`` and ``out/memory-<scope>``;
+``stop_policy.json`` and ``.md`` hold the choice (with its val grid) and the test rows, with
+95 % intervals clustered by room.
 """
 
 from __future__ import annotations
@@ -83,8 +83,8 @@ def choose_and_test(
     rules = {run: StopRule(**choice["chosen"]) for run, choice in zip(runs, choices, strict=True)}
     learned = [None] * len(runs)
     if map_memory != "off":
-        live = run_navigation(runs, navigator, ds, live_config,
-                              epsilon=epsilon, workers=workers, out=out / "memory", maps=maps,
+        live = run_navigation(runs, navigator, ds, live_config, epsilon=epsilon,
+                              workers=workers, out=out / f"memory-{map_memory}", maps=maps,
                               stop_rules=rules, progress=progress)  # fmt: skip
         learned = [case_rates(run["episodes"]) for run in live["runs"]]
     entries = []
