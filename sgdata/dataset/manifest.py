@@ -21,7 +21,12 @@ import jsonschema
 
 from sgdata.annotate.relations import RelationType
 from sgdata.dataset.paths import CARD, CROISSANT, MANIFEST, SPLITS
-from sgdata.dataset.schema import FORMAT_VERSION, manifest_json_schema, migrate_manifest_dict
+from sgdata.dataset.schema import (
+    FORMAT_VERSION,
+    SAME_RECIPE_AS,
+    manifest_json_schema,
+    migrate_manifest_dict,
+)
 from sgdata.errors import DatasetError
 from sgdata.fileio import sha256_file
 
@@ -212,8 +217,11 @@ class Manifest:
         """sha256 of what was asked for: every field but what generation produced (``counts``
         and ``files``). The same wherever the same config, seed, generator and format made
         the dataset, even where the bytes differ (renderers on other CPUs); results recorded
-        per dataset combine on it (DESIGN §12)."""
+        per dataset combine on it (DESIGN §12). A format that only added derived columns
+        counts as the one before it (:data:`~sgdata.dataset.schema.SAME_RECIPE_AS`)."""
         recipe = {k: v for k, v in self.to_dict().items() if k not in ("counts", "files")}
+        while recipe["format_version"] in SAME_RECIPE_AS:
+            recipe["format_version"] = SAME_RECIPE_AS[recipe["format_version"]]
         text = json.dumps(recipe, sort_keys=True, ensure_ascii=False, separators=(",", ":"))
         return hashlib.sha256(text.encode()).hexdigest()
 

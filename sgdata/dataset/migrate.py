@@ -8,6 +8,8 @@ with :func:`~sgdata.dataset.rows.write_parquet`; the manifest is written last, s
 stops half way leaves a dataset that still reads, and running again finishes it. PNG images of
 a dataset older than :data:`~sgdata.dataset.rows.PNG_STRATEGY_SINCE` are decoded and encoded
 again as ``generate`` now encodes them (lossless: the same pixels); JPEGs are kept as they are.
+Views of a dataset older than :data:`~sgdata.dataset.camera.CAMERA_SINCE` get their camera
+columns derived from their pose columns, as ``generate`` now writes them.
 Every table is written with the current schema's metadata (its ``format_version``, name and
 field docs): the reader keeps a file's own, which names the old version.
 """
@@ -22,6 +24,7 @@ import numpy as np
 import pyarrow as pa
 from PIL import Image
 
+from sgdata.dataset.camera import CAMERA_SINCE, camera_columns
 from sgdata.dataset.manifest import FileEntry, Manifest, read_manifest
 from sgdata.dataset.paths import observations_path, triplets_path
 from sgdata.dataset.publish import write_manifest
@@ -64,6 +67,7 @@ def migrate_dataset(root: str | Path) -> Manifest:
     }
     tables |= {triplets_path(s): triplets_schema() for s in manifest.splits}
     old_png = _parse_version(manifest.format_version) < _parse_version(PNG_STRATEGY_SINCE)
+    no_camera = _parse_version(manifest.format_version) < _parse_version(CAMERA_SINCE)
     files = []
     for entry in manifest.files:
         schema = tables.get(entry.path)
@@ -71,6 +75,8 @@ def migrate_dataset(root: str | Path) -> Manifest:
             table = read_table(root / entry.path, schema)
             if old_png and "image" in table.column_names:
                 table = _reencode_pngs(table, entry.path)
+            if no_camera and "camera_to_world" in table.column_names:
+                table = _with_cameras(table)
             table = _with_current_metadata(table, schema)
             info = write_parquet(table, root / entry.path)
             entry = FileEntry(entry.path, info.rows, info.sha256, info.bytes)
@@ -84,6 +90,15 @@ def _with_current_metadata(table: pa.Table, schema: pa.Schema) -> pa.Table:
     current schema's field and file metadata, not the old file's."""
     fields = [schema.field(n) for n in table.column_names]
     return pa.Table.from_arrays(table.columns, schema=pa.schema(fields, metadata=schema.metadata))
+
+
+def _with_cameras(table: pa.Table) -> pa.Table:
+    """The observation table with each view's camera derived from its pose columns (read
+    from an older file, they came back null)."""
+    intrinsics, poses = camera_columns(table)
+    table = table.set_column(table.schema.get_field_index("intrinsics"), "intrinsics", intrinsics)
+    at = table.schema.get_field_index("camera_to_world")
+    return table.set_column(at, "camera_to_world", poses)
 
 
 def _reencode_pngs(table: pa.Table, where: str) -> pa.Table:

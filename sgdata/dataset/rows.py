@@ -21,6 +21,7 @@ import pyarrow.parquet as pq
 from PIL import Image
 
 from sgdata.annotate.records import ViewRecord
+from sgdata.dataset.camera import camera_columns
 from sgdata.dataset.channels import encode_depth, encode_mask
 from sgdata.dataset.paths import SCENE_LAYER, obs_id
 from sgdata.dataset.schema import observations_schema, triplets_schema
@@ -258,6 +259,7 @@ def observation_table(
             pa.binary(),
         ),
     }
+    columns["intrinsics"], columns["camera_to_world"] = camera_columns(columns)
     return pa.Table.from_arrays([columns[f.name] for f in schema], schema=schema)
 
 

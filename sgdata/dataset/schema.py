@@ -50,6 +50,7 @@ __all__ = [
     "MIGRATIONS",
     "SCHEMA_PACKAGE",
     "OLDEST_READABLE",
+    "SAME_RECIPE_AS",
     "FormatVersionError",
     "check_compatible",
     "file_schema",
@@ -65,11 +66,13 @@ __all__ = [
     "since",
 ]
 
-FORMAT_VERSION = "2.1.0"  # semver of the whole on-disk format: tables + dataset.json
+FORMAT_VERSION = "2.2.0"  # semver of the whole on-disk format: tables + dataset.json
 # 1.1.0 added the observation columns textures, light_intensity and light_temperature; 2.0.0
 # stores `image` as the Hugging Face Image struct and adds README.md and croissant.json; 2.0.1
 # deflates PNGs with zlib's RLE strategy (same pixels, other bytes; readers change nothing).
 # 2.1.0 adds the optional per-view channels depth and instances (nullable image columns).
+# 2.2.0 adds each view's camera, intrinsics and camera_to_world (sgdata.dataset.camera),
+# derived from columns 2.1.0 has: `sgdata migrate` fills them in an older dataset.
 # The oldest format this sgdata reads: 1.x differs from 2.x only in how images are stored
 # (sgdata.dataset.storage reads both) and in lacking the card and Croissant files.
 OLDEST_READABLE = "1.0.0"
@@ -80,6 +83,10 @@ UPGRADE_HINT = "upgrade sgdata: pip install -U sgdata"
 # of the next version (with its format_version set). Empty: 1.1.0 only added nullable columns
 # (marked "since"), and 1.0.0 manifests need no change.
 MIGRATIONS: dict[str, Callable[[dict[str, Any]], dict[str, Any]]] = {}
+# version -> the version whose recipe it shares: a bump that only adds columns derived from
+# others asks the generator for nothing new, so a dataset keeps its recipe fingerprint (and the
+# results recorded on it, DESIGN §12) across it (Manifest.recipe_fingerprint)
+SAME_RECIPE_AS = {"2.2.0": "2.1.0"}
 _SEMVER = re.compile(r"^(0|[1-9]\d*)\.(0|[1-9]\d*)\.(0|[1-9]\d*)(?:[-+][0-9A-Za-z.+-]+)?$")
 log = logging.getLogger(__name__)
 

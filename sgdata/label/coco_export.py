@@ -11,6 +11,8 @@ area of its mask), ``iscrowd`` 0 and, with ``masks``, ``segmentation`` as compre
 its pixels in the instance mask (pycocotools' encoding). Category ids are the manifest class
 index + 1 (COCO keeps 0 for background), so a category id is also the value of that class in
 the class mask (:func:`sgdata.dataset.channels.class_mask`); every catalog class is listed.
+An image entry carries its view's camera where the dataset has it: ``intrinsics`` (K, 3 x 3)
+and ``camera_to_world`` (4 x 4, OpenCV axes; :mod:`sgdata.dataset.camera`).
 """
 
 from __future__ import annotations
@@ -82,7 +84,7 @@ def export_coco(
         {"id": c.id + 1, "name": c.name, "supercategory": c.dynamics} for c in ds.manifest.classes
     ]
     summary = CocoSummary(Path(out), masks=masks)
-    extra = ["instances"] if masks else []
+    extra = ["intrinsics", "camera_to_world", *(["instances"] if masks else [])]
     with staged_dir(Path(out), force=force) as stage:
         for name in splits:
             images, annotations = [], []
@@ -98,6 +100,7 @@ def export_coco(
                         "width": width,
                         "height": height,
                         "obs_id": row["obs_id"],
+                        **_camera(row),
                     }
                 )
                 mask = None
@@ -138,6 +141,20 @@ def export_coco(
             summary.images += len(images)
             summary.annotations += len(annotations)
     return summary
+
+
+def _camera(row: dict[str, Any]) -> dict[str, Any]:
+    """An image entry's camera (a dataset older than 2.2.0 has none until migrated): K as a
+    3 x 3 matrix and the 4 x 4 camera-to-world pose, as :mod:`sgdata.dataset.camera` states
+    them (OpenCV axes)."""
+    out: dict[str, Any] = {}
+    if row["intrinsics"] is not None:
+        fx, fy, cx, cy = row["intrinsics"]
+        out["intrinsics"] = [[fx, 0.0, cx], [0.0, fy, cy], [0.0, 0.0, 1.0]]
+    if row["camera_to_world"] is not None:
+        pose = row["camera_to_world"]
+        out["camera_to_world"] = [pose[4 * k : 4 * k + 4] for k in range(4)]
+    return out
 
 
 def _check_mask(mask: np.ndarray, row: dict[str, Any]) -> None:

@@ -1,4 +1,5 @@
-"""The pinhole camera the agent carries: intrinsics, pose and projection (no backend imports)."""
+"""The pinhole camera the agent carries: intrinsics, pose and projection (no backend imports;
+the pinhole model itself is :mod:`sgdata.pinhole`'s, which the dataset states per view)."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sgdata.errors import RenderError
+from sgdata.pinhole import OPENGL_FROM_OPENCV, basis, camera_to_world, focal_px
 
 __all__ = ["VIEW_SIZE", "CameraConfig"]
 
@@ -48,7 +50,7 @@ class CameraConfig:
     @property
     def focal(self) -> float:
         """Focal length in pixels (square pixels: fx = fy)."""
-        return (self.width / 2.0) / math.tan(math.radians(self.hfov_deg) / 2.0)
+        return focal_px(self.width, self.hfov_deg)
 
     @property
     def yfov(self) -> float:
@@ -57,20 +59,13 @@ class CameraConfig:
 
     def basis(self, theta: float) -> np.ndarray:
         """Rows right, up, forward (world unit vectors) for heading ``theta`` (rad about +Z)."""
-        p = math.radians(self.pitch_deg)
-        ct, st, cp, sp = math.cos(theta), math.sin(theta), math.cos(p), math.sin(p)
-        forward = np.array([ct * cp, st * cp, -sp])
-        right = np.array([st, -ct, 0.0])
-        up = np.cross(right, forward)
-        return np.stack([right, up, forward])
+        return basis(theta, self.pitch_deg)
 
     def pose_matrix(self, x: float, y: float, theta: float) -> np.ndarray:
-        """4x4 camera-to-world transform in OpenGL convention (camera looks along -Z, +Y up)."""
-        right, up, forward = self.basis(theta)
-        m = np.eye(4)
-        m[:3, 0], m[:3, 1], m[:3, 2] = right, up, -forward
-        m[:3, 3] = (x, y, self.eye_height)
-        return m
+        """4x4 camera-to-world transform in OpenGL convention (camera looks along -Z, +Y up):
+        the dataset's ``camera_to_world`` (OpenCV axes) turned to OpenGL's."""
+        cv = camera_to_world(x, y, theta, self.eye_height, self.pitch_deg)
+        return cv @ OPENGL_FROM_OPENCV
 
     def project(self, points: np.ndarray, x: float, y: float, theta: float) -> np.ndarray:
         """World points (N, 3) -> (N, 3) of continuous pixel u, v and forward depth (m)."""

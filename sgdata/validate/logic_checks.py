@@ -8,7 +8,9 @@ from typing import Any
 
 import numpy as np
 
+from sgdata.dataset.camera import CAMERA_SINCE, camera_columns
 from sgdata.dataset.paths import MANIFEST
+from sgdata.dataset.schema import _parse_version as _version
 from sgdata.validate.loading import Flat, SplitTables, column_numpy, flatten_list
 from sgdata.validate.problems import Collector
 
@@ -72,6 +74,33 @@ def check_rows(tables: SplitTables, raw: dict[str, Any], out: Collector) -> None
         f"{width[k]}x{height[k]}; {MANIFEST} image is {image['width']}x{image['height']}"
     )
     _report(out, tables, "rows.camera", bad, rows, "camera", msg)
+    if _version(raw["format_version"]) >= _version(CAMERA_SINCE):
+        _check_stated_camera(tables, rows, out)
+
+
+def _check_stated_camera(tables: SplitTables, rows: np.ndarray, out: Collector) -> None:
+    """Each view's ``intrinsics`` and ``camera_to_world`` are what its pose and camera
+    columns give (:func:`sgdata.dataset.camera.camera_columns`); null where those are."""
+    obs = tables.observations
+    for name, derived in zip(("intrinsics", "camera_to_world"), camera_columns(obs), strict=True):
+        stated = obs.column(name).to_pylist()
+        wanted = derived.to_pylist()
+        bad = np.array([_differs(a, b) for a, b in zip(stated, wanted, strict=True)], bool)
+        msg = lambda k, s=stated, w=wanted: (  # noqa: E731
+            f"{_short(s[k])}; the row's x, y, theta and camera give {_short(w[k])} "
+            "(regenerate, or run sgdata migrate on a dataset written before the camera)"
+        )
+        _report(out, tables, "rows.camera", bad, rows, name, msg)
+
+
+def _differs(stated: list[float] | None, wanted: list[float] | None) -> bool:
+    if stated is None or wanted is None:
+        return (stated is None) != (wanted is None)
+    return not np.allclose(stated, wanted, rtol=1e-9, atol=1e-9)
+
+
+def _short(values: list[float] | None) -> str:
+    return "null" if values is None else "[" + ", ".join(f"{v:.4g}" for v in values) + "]"
 
 
 def _instance_codes(*arrays: np.ndarray) -> tuple[list[np.ndarray], int]:

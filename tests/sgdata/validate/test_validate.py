@@ -237,6 +237,18 @@ def test_box2d_outside_image(copy: Path) -> None:
     assert checks(report) == {"objects.box2d"}
 
 
+def test_a_stated_camera_that_its_pose_does_not_give(copy: Path) -> None:
+    rows, schema = rows_of(copy, SHARD)
+    rows[2]["camera_to_world"][3] += 0.25  # the camera 25 cm off its stated x
+    rows[3]["intrinsics"] = None
+    rewrite(copy, SHARD, pa.Table.from_pylist(rows, schema=schema))
+    report = validate_dataset(copy, quick=True)
+    dropped, moved = find(report, "rows.camera")  # by column, then row
+    assert (moved.file, moved.row, moved.field) == (SHARD, 2, "camera_to_world")
+    assert (dropped.row, dropped.field) == (3, "intrinsics") and "null;" in dropped.message
+    assert "sgdata migrate" in moved.message and checks(report) == {"rows.camera"}
+
+
 def test_one_way_proximity(copy: Path) -> None:
     rows, schema = rows_of(copy, SHARD)
     k = _first(rows, lambda r: any(e["type"] == 2 for e in r["relations"]))
@@ -420,7 +432,9 @@ def test_a_format_1_1_dataset_reads_validates_and_migrates(copy: Path, mini_data
     old, new = Dataset.open(copy), Dataset.open(mini_dataset)
     assert old.manifest.format_version == "1.1.0"  # read as it is, not renamed
     before, after = old.observations("train"), new.observations("train")
-    assert before.drop_columns(["image"]).equals(after.drop_columns(["image"]))
+    derived = ["intrinsics", "camera_to_world"]  # 2.2.0's: null in an older file until migrated
+    assert before.column("camera_to_world").null_count == before.num_rows
+    assert before.drop_columns(["image", *derived]).equals(after.drop_columns(["image", *derived]))
     assert not before.column("image").equals(after.column("image"))  # other bytes, same pixels
     for a, b in zip(pixels(before.column("image")), pixels(after.column("image")), strict=True):
         assert np.array_equal(a, b)
