@@ -330,13 +330,16 @@ def render(
     overlay_path = output.with_suffix(".overlay.png")
     save_png(Image.fromarray(record.rgb), output)
     save_png(draw_overlay(record), overlay_path)
-    class_ids = {c.name: c.id for c in class_vocabulary(catalog)[1]}
+    vocabulary = class_vocabulary(catalog)[1]
+    class_ids = {c.name: c.id for c in vocabulary}
     channels_path = output.with_suffix(".channels.png")
     strip = channel_strip(
         record.rgb,
         depth=record.depth,
         instances=record.instances,
         class_ids=np.array([class_ids[c] for c in record.obj_class], dtype=np.int64),
+        structure=record.structure,
+        n_classes=len(vocabulary),
     )
     save_png(strip, channels_path)
     counts = np.bincount(record.rel_type, minlength=4) if len(record.rel_type) else [0] * 4
@@ -428,11 +431,12 @@ def diff(
 def migrate(
     root: Annotated[Path, typer.Argument(help=DATASET_ROOT)],
 ) -> None:
-    """Rewrite a format 1.x dataset in the current format, in place (card and croissant.json
-    included)."""
+    """Rewrite a dataset of an older format in the current format, in place (card and
+    croissant.json included; structure masks drawn for one that stores instance masks)."""
     from sgdata.dataset import migrate_dataset
+    from sgdata.pipeline.structure_masks import structure_column
 
-    manifest = migrate_dataset(root)
+    manifest = migrate_dataset(root, draw_structure=structure_column)
     console.print(f"{root}: format {manifest.format_version}, {len(manifest.files)} files")
 
 

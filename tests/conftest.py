@@ -476,9 +476,9 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
 # A test marked `quiet` needs the machine to itself: it times the machine (a budget's
 # calibration against busy loops, whose quiet side must be quiet), or it starts a local Ray,
 # whose start-up beside busy workers takes up to 8 times as long. Under xdist it runs while
-# the other workers wait. Every other test holds a shared lock while it runs (set-up and teardown included); a
-# quiet one takes it exclusively. The gate keeps new shared holders out while a quiet test
-# waits, so it is not starved.
+# the other workers wait. Every other test holds a shared lock while it runs (set-up and
+# teardown included); a quiet one takes it exclusively. The gate keeps new shared holders out
+# while a quiet test waits, so it is not starved.
 
 
 @contextlib.contextmanager

@@ -1,4 +1,4 @@
-"""The per-view channels as loader arrays: metric depth, the instance mask and the class mask.
+"""The per-view channels as loader arrays: metric depth, the instance, class and structure masks.
 
 The datasets (:class:`~seannet.data.datasets.ObservationDataset`,
 :class:`~seannet.data.datasets.TripletDataset`) read them when asked
@@ -9,8 +9,11 @@ blended), one ``(S, S)`` array per view and channel:
 
 - ``depth``: float32 metres along the camera axis, 0 where nothing was hit;
 - ``instances``: int64, 0 background, k the k-th object of the row's ``objects`` list;
-- ``classes``: int64, the class mask derived from ``instances`` and the objects' class ids
-  (:func:`sgdata.dataset.channels.class_mask`: class id + 1, 0 background).
+- ``classes``: int64, the objects' class mask derived from ``instances`` and the objects'
+  class ids (:func:`sgdata.dataset.channels.class_mask`: class id + 1, 0 elsewhere);
+- ``structure``: int64, the part of the room seen where no object is (1 wall, 2 floor,
+  3 ceiling, 4 door; 0 elsewhere), stored since format 2.3.0. Ask for it beside ``classes``
+  for the room's parts as classes too (``class_mask``'s ``structure`` argument).
 """
 
 from __future__ import annotations
@@ -40,9 +43,20 @@ __all__ = [
     "stored_columns",
 ]
 
-LOADER_CHANNELS = ("depth", "instances", "classes")  # what a loader can be asked for
-_SOURCE = {"depth": "depth", "instances": "instances", "classes": "instances"}  # column read
-_DTYPES = {"depth": np.float32, "instances": np.int64, "classes": np.int64}
+LOADER_CHANNELS = ("depth", "instances", "classes", "structure")  # what a loader can be asked
+# loader channel -> the column it is read from
+_SOURCE = {
+    "depth": "depth",
+    "instances": "instances",
+    "classes": "instances",
+    "structure": "structure",
+}
+_DTYPES = {"depth": np.float32, "instances": np.int64, "classes": np.int64, "structure": np.int64}
+_HOW = {  # how to make a dataset that stores a column
+    "depth": "[outputs] depth = true",
+    "instances": "[outputs] instances = true",
+    "structure": "[outputs] instances = true (format 2.3.0 on; sgdata migrate an older one)",
+}
 
 
 def check_loader_channels(ds: Any, channels: Iterable[str], *, root: str | Path) -> tuple[str, ...]:
@@ -58,13 +72,13 @@ def check_loader_channels(ds: Any, channels: Iterable[str], *, root: str | Path)
         raise DataError(
             f"channels {names}: expected distinct names among {', '.join(LOADER_CHANNELS)}"
         )
-    stored = stored_channels(ds.manifest.config)
+    stored = stored_channels(ds.manifest.config, ds.manifest.format_version)
     for name in names:
         column = _SOURCE[name]
         if column not in stored:
             raise DataError(
                 f"dataset {root} ({ds.manifest.name}) has no {name} channel (a real labelled "
-                f"dataset has none; generate one with [outputs] {column} = true), or ask for "
+                f"dataset has none; generate one with {_HOW[column]}), or ask for "
                 "no channels"
             )
     return names

@@ -6,6 +6,8 @@ It keeps the renderer and the layout's object table alive between views and retu
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from sgdata.annotate.boxes import ObjectTable, annotate
@@ -17,6 +19,7 @@ from sgdata.render.camera import CameraConfig
 from sgdata.render.renderer import Renderer
 from sgdata.stage_clock import NO_CLOCK, Clock
 from sgdata.usd.meshes import Lighting, SceneGeometry
+from sgdata.usd.room_io import door_quad
 from sgdata.world.scene import Room
 
 __all__ = ["VIEW_STEPS", "ViewAnnotator"]
@@ -69,7 +72,9 @@ class ViewAnnotator:
         return self.renderer.camera
 
     def set_layout(self, room: Room, geometry: SceneGeometry, layout: int) -> None:
-        """Load a layout: moves the renderer's nodes (rebuilds only for a new room)."""
+        """Load a layout: moves the renderer's nodes (rebuilds only for a new room); the id
+        pass also draws the room's door opening (the structure mask's door)."""
+        geometry = replace(geometry, door=door_quad(room))
         if self._room is not None and self._room.room_id == room.room_id:
             self.renderer.update_poses(geometry)
         else:
@@ -148,4 +153,5 @@ class ViewAnnotator:
             light_temperature=self._lighting.temperature,
             depth=rendered.depth if self.keep_depth else None,
             instances=ann.instance_mask(keep) if self.keep_instances else None,
+            structure=rendered.structure if self.keep_instances else None,
         )

@@ -75,6 +75,8 @@ class ViewRecord:
     depth: np.ndarray | None = field(default=None, repr=False)  # (H, W) float32 if kept
     # (H, W) uint16 if kept: 0 background, k where the k-th object of the obj_* columns is seen
     instances: np.ndarray | None = field(default=None, repr=False)
+    # (H, W) uint8 if kept, with instances: the structure part seen (dataset.channels)
+    structure: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def num_objects(self) -> int:

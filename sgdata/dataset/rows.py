@@ -105,7 +105,7 @@ def _check_record(rec: ViewRecord) -> int:
         )
     if not len(rec.rel_src) == len(rec.rel_dst) == len(rec.rel_type):
         raise DatasetError(f"view {rec.room_id}: rel_src, rel_dst, rel_type lengths differ")
-    for name in ("rgb", "depth", "instances"):
+    for name in ("rgb", "depth", "instances", "structure"):
         image = getattr(rec, name)
         if image is not None and image.shape[:2] != (rec.image_height, rec.image_width):
             raise DatasetError(
@@ -256,6 +256,13 @@ def observation_table(
         ),
         "instances": pa.array(
             [None if r.instances is None else encode_mask(r.instances) for r in records],
+            pa.binary(),
+        ),
+        "structure": pa.array(
+            [
+                None if r.structure is None else encode_mask(r.structure.astype(np.uint16))
+                for r in records
+            ],
             pa.binary(),
         ),
     }

@@ -56,6 +56,7 @@ __all__ = [
     "file_schema",
     "migrate_manifest_dict",
     "observations_schema",
+    "parse_version",
     "triplets_schema",
     "manifest_json_schema",
     "table_schema",
@@ -66,13 +67,15 @@ __all__ = [
     "since",
 ]
 
-FORMAT_VERSION = "2.2.0"  # semver of the whole on-disk format: tables + dataset.json
+FORMAT_VERSION = "2.3.0"  # semver of the whole on-disk format: tables + dataset.json
 # 1.1.0 added the observation columns textures, light_intensity and light_temperature; 2.0.0
 # stores `image` as the Hugging Face Image struct and adds README.md and croissant.json; 2.0.1
 # deflates PNGs with zlib's RLE strategy (same pixels, other bytes; readers change nothing).
 # 2.1.0 adds the optional per-view channels depth and instances (nullable image columns).
 # 2.2.0 adds each view's camera, intrinsics and camera_to_world (sgdata.dataset.camera),
 # derived from columns 2.1.0 has: `sgdata migrate` fills them in an older dataset.
+# 2.3.0 adds the structure mask (wall, floor, ceiling, door), stored with the instance mask;
+# `sgdata migrate` renders it for an older dataset that stores instance masks.
 # The oldest format this sgdata reads: 1.x differs from 2.x only in how images are stored
 # (sgdata.dataset.storage reads both) and in lacking the card and Croissant files.
 OLDEST_READABLE = "1.0.0"
@@ -83,10 +86,11 @@ UPGRADE_HINT = "upgrade sgdata: pip install -U sgdata"
 # of the next version (with its format_version set). Empty: 1.1.0 only added nullable columns
 # (marked "since"), and 1.0.0 manifests need no change.
 MIGRATIONS: dict[str, Callable[[dict[str, Any]], dict[str, Any]]] = {}
-# version -> the version whose recipe it shares: a bump that only adds columns derived from
-# others asks the generator for nothing new, so a dataset keeps its recipe fingerprint (and the
+# version -> the version whose recipe it shares: a bump that only adds what the same config
+# and seed already determine (columns derived from others, a mask drawn from the same scene)
+# asks the generator for nothing new, so a dataset keeps its recipe fingerprint (and the
 # results recorded on it, DESIGN §12) across it (Manifest.recipe_fingerprint)
-SAME_RECIPE_AS = {"2.2.0": "2.1.0"}
+SAME_RECIPE_AS = {"2.2.0": "2.1.0", "2.3.0": "2.2.0"}
 _SEMVER = re.compile(r"^(0|[1-9]\d*)\.(0|[1-9]\d*)\.(0|[1-9]\d*)(?:[-+][0-9A-Za-z.+-]+)?$")
 log = logging.getLogger(__name__)
 
@@ -159,7 +163,7 @@ def _parse_field(spec: Any, parent: str) -> pa.Field:
         metadata[STORAGE_KEY] = _IMAGE.encode()
     if "since" in spec:
         added = spec["since"]
-        if not spec["nullable"] or _parse_version(added) > _parse_version(FORMAT_VERSION):
+        if not spec["nullable"] or parse_version(added) > parse_version(FORMAT_VERSION):
             raise DatasetError(
                 f"{where}: since {added!r}; only a nullable column may be added, in a version "
                 f"up to {FORMAT_VERSION}"
@@ -182,8 +186,8 @@ def schema_at(schema: pa.Schema, version: str) -> pa.Schema:
     Raises:
         FormatVersionError: ``version`` is not a semantic version.
     """
-    at = _parse_version(version)
-    keep = [f for f in schema if since(f) is None or _parse_version(since(f)) <= at]
+    at = parse_version(version)
+    keep = [f for f in schema if since(f) is None or parse_version(since(f)) <= at]
     return pa.schema(keep, metadata=schema.metadata)
 
 
@@ -196,7 +200,7 @@ def file_schema(schema: pa.Schema, version: str = FORMAT_VERSION) -> pa.Schema:
         FormatVersionError: ``version`` is not a semantic version.
     """
     at = schema_at(schema, version)
-    if _parse_version(version) < _parse_version(IMAGE_STORAGE_SINCE) or not any(
+    if parse_version(version) < parse_version(IMAGE_STORAGE_SINCE) or not any(
         is_image_field(f) for f in at
     ):
         return at
@@ -268,7 +272,12 @@ class FormatVersionError(DatasetError):
     """The dataset's ``format_version`` is malformed or not readable by this sgdata."""
 
 
-def _parse_version(version: object) -> tuple[int, int, int]:
+def parse_version(version: object) -> tuple[int, int, int]:
+    """``(major, minor, patch)`` of a format version (pre-release and build tags dropped).
+
+    Raises:
+        FormatVersionError: not a semantic version.
+    """
     match = _SEMVER.match(version) if isinstance(version, str) else None
     if match is None:
         raise FormatVersionError(
@@ -287,9 +296,9 @@ def check_compatible(manifest_version: str, *, current: str | None = None) -> No
     Raises:
         FormatVersionError: malformed version, or a major outside that range.
     """
-    major = _parse_version(manifest_version)[0]
-    ours = _parse_version(current or FORMAT_VERSION)[0]
-    oldest = min(_parse_version(OLDEST_READABLE)[0], ours)
+    major = parse_version(manifest_version)[0]
+    ours = parse_version(current or FORMAT_VERSION)[0]
+    oldest = min(parse_version(OLDEST_READABLE)[0], ours)
     if major > ours:
         raise FormatVersionError(
             f"dataset.json format_version {manifest_version} is newer than this sgdata reads "
@@ -324,7 +333,7 @@ def migrate_manifest_dict(
     version = raw.get("format_version")
     check_compatible(version, current=current)
     seen: set[str] = set()
-    while _parse_version(version) < _parse_version(current) and version in migrations:
+    while parse_version(version) < parse_version(current) and version in migrations:
         if version in seen:
             raise FormatVersionError(f"manifest migrations loop at format_version {version}")
         seen.add(version)
@@ -333,7 +342,7 @@ def migrate_manifest_dict(
         check_compatible(new, current=current)
         log.info("migrated dataset.json from format %s to %s", version, new)
         version = new
-    if _parse_version(version) > _parse_version(current):
+    if parse_version(version) > parse_version(current):
         known = set(manifest_json_schema()["properties"])
         dropped = sorted(set(raw) - known)
         if dropped:

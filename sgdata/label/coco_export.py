@@ -176,7 +176,7 @@ def _require_masks(ds: Any, dataset_dir: Path) -> None:
     """Refuse ``--masks`` on a dataset that stores no instance masks."""
     from sgdata.dataset.channels import stored_channels
 
-    if "instances" not in stored_channels(ds.manifest.config):
+    if "instances" not in stored_channels(ds.manifest.config, ds.manifest.format_version):
         real = "a real (labelled) dataset has none; " if is_real(ds) else ""
         raise ConfigError(
             f"--masks: {dataset_dir} has no instance masks ({real}generate it with "

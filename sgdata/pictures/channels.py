@@ -49,6 +49,8 @@ def channel_strip(
     depth: np.ndarray | None,
     instances: np.ndarray | None,
     class_ids: np.ndarray | None = None,
+    structure: np.ndarray | None = None,
+    n_classes: int = 0,
 ) -> Image.Image:
     """RGB | depth | instances | classes side by side, each panel titled; a channel that is
     None is left out (the class panel needs ``instances`` and ``class_ids``).
@@ -58,6 +60,8 @@ def channel_strip(
         depth: (H, W) metres (0: no hit) or None.
         instances: (H, W) uint16 instance mask or None.
         class_ids: the listed objects' class ids (for the class panel).
+        structure: (H, W) structure mask or None; the class panel then shows the room's
+            parts too, as classes after the ``n_classes`` of the catalog.
     """
     panels = [("rgb", rgb)]
     if depth is not None:
@@ -65,7 +69,8 @@ def channel_strip(
     if instances is not None:
         panels.append(("instances", colour_mask(instances)))
         if class_ids is not None:
-            panels.append(("classes", colour_mask(class_mask(instances, class_ids))))
+            classes = class_mask(instances, class_ids, structure, n_classes=n_classes)
+            panels.append(("classes", colour_mask(classes)))
     h, w = rgb.shape[:2]
     title = 14
     strip = Image.new("RGB", (len(panels) * w + (len(panels) - 1) * 4, h + title), "white")

@@ -183,21 +183,27 @@ def channel_sheet(ds: Dataset, *, views: int = 3) -> Image.Image | None:
     """The first ``views`` views of the first split that stores channels, each as its strip
     RGB | depth | instances | classes (:func:`sgdata.pictures.channels.channel_strip`); None
     when the dataset stores no channel."""
-    from sgdata.dataset.channels import decode_channel, depth_metres, stored_channels
+    from sgdata.dataset.channels import CHANNELS, decode_channel, depth_metres, stored_channels
     from sgdata.pictures.channels import channel_strip
 
-    if not stored_channels(ds.manifest.config):
+    if not stored_channels(ds.manifest.config, ds.manifest.format_version):
         return None
-    columns = ["image", "depth", "instances", "objects"]
+    n_classes = len(ds.manifest.classes)
+    stored = stored_channels(ds.manifest.config, ds.manifest.format_version)
+    columns = ["image", *stored, "objects"]
     rows = ds.observations(ds.splits[0], columns=columns).slice(0, views).to_pylist()
     strips = []
     for row in rows:
         with Image.open(io.BytesIO(row["image"])) as decoded:
             rgb = np.asarray(decoded.convert("RGB"))
-        depth = None if row["depth"] is None else depth_metres(decode_channel(row["depth"]))
-        mask = None if row["instances"] is None else decode_channel(row["instances"])
+        cells = {c: row.get(c) for c in CHANNELS}
+        depth = None if cells["depth"] is None else depth_metres(decode_channel(cells["depth"]))
+        mask, parts = (None if cells[c] is None else decode_channel(cells[c]) for c in CHANNELS[1:])
         ids = np.array([o["class_id"] for o in row["objects"]], dtype=np.int64)
-        strips.append(channel_strip(rgb, depth=depth, instances=mask, class_ids=ids))
+        strip = channel_strip(
+            rgb, depth=depth, instances=mask, class_ids=ids, structure=parts, n_classes=n_classes
+        )
+        strips.append(strip)
     if not strips:
         return None
     sheet = Image.new("RGB", (strips[0].width, sum(s.height + 6 for s in strips)), "white")

@@ -8,9 +8,10 @@ world-space float32 vertices, in the same order and with the same culling as the
 primitives (:func:`sgdata.render.primitives.face_order`), so where two faces tie in depth
 the same one wins in both passes. Each vertex carries its object's dense index + 1 as an
 unsigned integer (``flat``: never interpolated), written as a 24-bit colour (``k / 255``
-converts back to ``k`` exactly), structure 0; a draw then a read-back of the colour gives
-the codes. The vertex shader computes the position as pyrender's mesh shader does
-(``P * V * M * inst_m * position``, here with ``M`` and ``inst_m`` the identity).
+converts back to ``k`` exactly), structure faces the code their caller gives them (one per
+part: :mod:`sgdata.render.structure`); a draw then a read-back of the colour gives the codes.
+The vertex shader computes the position as pyrender's mesh shader does (``P * V * M * inst_m
+* position``, here with ``M`` and ``inst_m`` the identity).
 """
 
 from __future__ import annotations
@@ -73,22 +74,22 @@ class MergedIdPass:
 
     def load(
         self,
-        structure: tuple[MeshData, ...],
+        structure: list[tuple[MeshData, np.ndarray]],
         objects: MeshData,
         owner: np.ndarray,
         *,
         textured: bool,
     ) -> None:
-        """Upload a room: ``structure`` meshes (code 0), ``objects`` merged in world space
-        with ``owner[f]`` the code of face ``f``; ``textured`` as the RGB pass draws them
-        (it sets the face order)."""
+        """Upload a room: ``structure`` meshes, each with its faces' codes, drawn
+        double-sided, then ``objects`` merged in world space with ``owner[f]`` the code of
+        face ``f``; ``textured`` as the RGB pass draws them (it sets the face order)."""
         parts: list[tuple[np.ndarray, np.ndarray]] = []
         ranges, first = [], 0
-        for mesh, codes, cull in [(m, None, False) for m in structure] + [(objects, owner, True)]:
+        for mesh, codes, cull in [(m, c, False) for m, c in structure] + [(objects, owner, True)]:
             order = face_order(mesh, textured)
             faces = np.asarray(mesh.faces, dtype=np.int64)[order]
             tri = np.asarray(mesh.vertices, dtype=np.float64)[faces].reshape(-1, 3)
-            code = np.zeros(len(order), np.uint32) if codes is None else codes[order]
+            code = np.asarray(codes, np.uint32)[order]
             parts.append((tri.astype(np.float32), np.repeat(code.astype(np.uint32), 3)))
             ranges.append((first, 3 * len(order), cull))
             first += 3 * len(order)

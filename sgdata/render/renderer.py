@@ -10,7 +10,8 @@ to the id pass; only a different instance set rebuilds everything.
 Instance ids come from one of two id passes (``id_pass``), both exact (no blended values):
 
 - ``"raster"`` (default): the RGB pass's own triangles drawn in one call with each object's
-  dense index + 1 as a flat 24-bit colour (structure encodes 0, so walls occlude), into a
+  dense index + 1 as a flat 24-bit colour (structure faces the codes after them, one per
+  part of :mod:`sgdata.render.structure`, so walls occlude and are told apart), into a
   single-sample framebuffer, so no value is ever blended (:mod:`sgdata.render.id_pass`,
   :mod:`sgdata.render.target`). Decoded codes are still validated against the known range
   on every view and a bad one raises ``RenderError``.
@@ -60,8 +61,10 @@ from sgdata.render.primitives import (
     same_shape,
     texture,
 )
+from sgdata.render.structure import face_parts
 from sgdata.render.target import use_single_sample_target
 from sgdata.render.uniforms import cache_uniform_locations
+from sgdata.room_parts import DOOR, STRUCTURE_PARTS
 from sgdata.usd.meshes import Lighting, MeshData, SceneGeometry
 
 __all__ = ["RenderedView", "Renderer", "ceiling_light_pose", "use_egl_platform"]
@@ -91,11 +94,14 @@ def use_egl_platform() -> None:
 
 @dataclass
 class RenderedView:
-    """One rendered view. ``instance`` holds instance ids, -1 for background and structure."""
+    """One rendered view. ``instance`` holds instance ids, -1 for background and structure;
+    ``structure`` the part of the room's structure seen (:data:`STRUCTURE_PARTS` k + 1), 0
+    for an object or nothing."""
 
     rgb: np.ndarray  # (H, W, 3) uint8, sRGB
     instance: np.ndarray  # (H, W) int32
     depth: np.ndarray | None  # (H, W) float32 metres along the view axis, 0 where empty
+    structure: np.ndarray | None = None  # (H, W) uint8
 
 
 _SEG_LIMIT = 1 << 24  # 24-bit colour codes
@@ -159,7 +165,9 @@ class Renderer:
         self._scene: Any = None
         self._rank: dict[Any, int] = {}  # mesh node -> the order it was added in
         self._merged_node: Any = None
-        self._instance_lut = np.full(1, -1, dtype=np.int32)  # dense index + 1 -> instance
+        self._instance_lut = np.full(1, -1, dtype=np.int32)  # id pass code -> instance
+        self._part_lut = np.zeros(1, dtype=np.uint8)  # id pass code -> structure part
+        self._door: MeshData | None = None
         self._rays_cam = self._camera_rays()
         self._rc: Any = None
         self._matrices: list[np.ndarray] = []
@@ -178,15 +186,17 @@ class Renderer:
         RGB pass and, as codes, by the id pass."""
         pr = self._pr
         n = len(scene.objects)
-        if n + 1 >= _SEG_LIMIT:
-            raise RenderError(
-                f"{n} objects in one scene: the id pass encodes at most {_SEG_LIMIT - 2}"
-            )
-        self._structure = scene.structure
+        if n + 1 + len(STRUCTURE_PARTS) >= _SEG_LIMIT:
+            limit = _SEG_LIMIT - 2 - len(STRUCTURE_PARTS)
+            raise RenderError(f"{n} objects in one scene: the id pass encodes at most {limit}")
+        self._structure, self._door = scene.structure, scene.door
         self._meshes = [obj.mesh for obj in scene.objects]
         self._matrices = [np.asarray(o.matrix) for o in scene.objects]
         self._instances = tuple(int(o.instance) for o in scene.objects)
-        self._instance_lut = np.array((-1, *self._instances), dtype=np.int32)
+        # codes: 0 nothing drawn, 1..n the objects, then one per structure part
+        parts = len(STRUCTURE_PARTS)
+        self._instance_lut = np.array((-1, *self._instances, *[-1] * parts), dtype=np.int32)
+        self._part_lut = np.r_[np.zeros(n + 1), np.arange(1, parts + 1)].astype(np.uint8)
         # a dim hallway grey behind the door gap rather than a black hole
         sc = pr.Scene(bg_color=[0.45, 0.45, 0.48, 1.0], ambient_light=[self.ambient] * 3)
         self._scene, self._rank = sc, {}
@@ -213,7 +223,16 @@ class Renderer:
         self._merged_node = self._add(self._pr.Mesh(self._primitives(merged)))
         counts = [len(o.mesh.faces) for o in scene.objects]
         owner = np.repeat(np.arange(1, len(counts) + 1, dtype=np.uint32), counts)
-        self._ids.load(scene.structure, merged, owner, textured=self.textures)
+        self._ids.load(self._structure_codes(), merged, owner, textured=self.textures)
+
+    def _structure_codes(self) -> list[tuple[MeshData, np.ndarray]]:
+        """Each structure mesh (the door's opening last) with its faces' id pass codes."""
+        n = len(self._meshes)
+        meshes = [*self._structure, *([self._door] if self._door is not None else [])]
+        parts = face_parts(self._structure)
+        if self._door is not None:
+            parts.append(np.full(len(self._door.faces), DOOR, np.uint8))
+        return [(m, n + p.astype(np.uint32)) for m, p in zip(meshes, parts, strict=True)]
 
     def _add(self, node_or_mesh: Any, **kwargs: Any) -> Any:
         """Add to the scene, remembering the order (the draw order's tie-break)."""
@@ -254,6 +273,7 @@ class Renderer:
             and len(scene.structure) == len(self._structure)
             and all(same_shape(o.mesh, m) for o, m in zip(scene.objects, self._meshes, strict=True))
             and all(same_mesh(a, b) for a, b in zip(scene.structure, self._structure, strict=True))
+            and _same_door(scene.door, self._door)
         )
         if not same:
             self.load(scene)
@@ -292,7 +312,10 @@ class Renderer:
         stage's own light. ``depth=False`` skips reading depth back (the view's depth is None).
         """
         rgb, metres = self.render_rgb(x, y, theta, rng=rng, depth=depth)
-        return RenderedView(rgb=rgb, instance=self.render_ids(x, y, theta), depth=metres)
+        code = self._codes(x, y, theta, self.id_pass)
+        return RenderedView(
+            rgb=rgb, instance=self._instance_lut[code], depth=metres, structure=self._part_lut[code]
+        )
 
     def render_rgb(
         self,
@@ -332,17 +355,23 @@ class Renderer:
 
         ``id_pass`` overrides the renderer's default for this call.
         """
+        code = self._codes(x, y, theta, self.id_pass if id_pass is None else id_pass)
+        return self._instance_lut[code]
+
+    def render_structure(self, x: float, y: float, theta: float) -> np.ndarray:
+        """The id pass only: (H, W) uint8 structure parts, as :attr:`RenderedView.structure`."""
+        return self._part_lut[self._codes(x, y, theta, self.id_pass)]
+
+    def _codes(self, x: float, y: float, theta: float, method: str) -> np.ndarray:
+        """(H, W) id pass codes (indices into the instance and part tables)."""
         self._require_scene()
-        method = self.id_pass if id_pass is None else id_pass
         if method == "raycast":
             if self._rc is None:
                 self._build_raycaster(self._matrices)
-            index = self._raycast_index(x, y, theta)
-        elif method == "raster":
-            index = self._raster_index(x, y, theta)
-        else:
-            raise RenderError(f"id_pass={method!r}: expected 'raycast' or 'raster'")
-        return self._instance_lut[index]
+            return self._raycast_index(x, y, theta)
+        if method == "raster":
+            return self._raster_index(x, y, theta)
+        raise RenderError(f"id_pass={method!r}: expected 'raycast' or 'raster'")
 
     def close(self) -> None:
         """Free the GL context (also done when the renderer is garbage-collected).
@@ -426,15 +455,15 @@ class Renderer:
         import open3d as o3d  # late: heavy, only needed for this id pass
 
         verts, faces, owner, offset = [], [], [], 0
-        meshes = [(m, np.eye(4), -1) for m in self._structure] + [
-            (mesh, np.asarray(mat), k)
+        meshes = [(m, np.eye(4), codes) for m, codes in self._structure_codes()] + [
+            (mesh, np.asarray(mat), np.full(len(mesh.faces), k + 1))
             for k, (mesh, mat) in enumerate(zip(self._meshes, matrices, strict=True))
         ]
-        for mesh, mat, k in meshes:
+        for mesh, mat, codes in meshes:
             v = np.asarray(mesh.vertices, dtype=np.float64) @ mat[:3, :3].T + mat[:3, 3]
             verts.append(v)
             faces.append(np.asarray(mesh.faces, dtype=np.int64) + offset)
-            owner.append(np.full(len(mesh.faces), k + 1, dtype=np.int32))
+            owner.append(np.asarray(codes, dtype=np.int32))
             offset += len(v)
         rc = o3d.t.geometry.RaycastingScene()
         if offset:
@@ -457,6 +486,10 @@ class Renderer:
         prim = hit["primitive_ids"].numpy().astype(np.int64)
         prim[prim >= len(self._face_owner) - 1] = len(self._face_owner) - 1  # misses
         return self._face_owner[prim].reshape(cam.height, cam.width)
+
+
+def _same_door(a: MeshData | None, b: MeshData | None) -> bool:
+    return a is b or (a is not None and b is not None and same_mesh(a, b))
 
 
 def ceiling_light_pose(scene: SceneGeometry) -> np.ndarray:

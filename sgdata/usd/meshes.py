@@ -64,6 +64,7 @@ class SceneGeometry:
     structure: tuple[MeshData, ...]  # floor, walls, ceiling in world coordinates
     objects: tuple[ObjectGeometry, ...]
     lighting: Lighting = Lighting()
+    door: MeshData | None = None  # the door opening, for the id pass only (render.structure)
 
 
 def merge_meshes(meshes: Sequence[MeshData], name: str = "") -> MeshData:

@@ -36,6 +36,7 @@ import numpy as np
 from pxr import Gf, Kind, Sdf, Usd, UsdGeom, Vt
 
 from sgdata.errors import SceneError, UsdError
+from sgdata.usd.meshes import MeshData
 from sgdata.usd.prims import OBJECTS, ROOT, STRUCTURE, object_path
 from sgdata.usd.stage import open_stage, write_usd_file
 from sgdata.world.scene import WALLS, Dynamics, Opening, Placement, Room, SceneObject
@@ -51,6 +52,7 @@ __all__ = [
     "ObjectTextures",
     "TexturedGeometry",
     "catalog_geometry",
+    "door_quad",
     "write_room",
     "read_room",
 ]
@@ -369,6 +371,29 @@ def _structure_meshes(room: Room) -> dict[str, tuple[np.ndarray, np.ndarray, np.
         colors = np.tile(np.asarray(color or _DEFAULT_FLOOR, np.float32), (len(tris), 1))
         meshes[name] = (tris.reshape(-1, 3), faces, colors)
     return meshes
+
+
+DOOR_BEHIND = 0.5  # metres behind the door wall's inner plane: past any wall (0.1 m here)
+DOOR_MARGIN = 2.0  # metres the door rectangle reaches past the opening on each side
+
+
+def door_quad(room: Room) -> MeshData:
+    """The room's door opening as the id pass draws it (:attr:`SceneGeometry.door`): a
+    rectangle in the room frame, :data:`DOOR_BEHIND` behind the door's wall and
+    :data:`DOOR_MARGIN` larger than the opening on every side. Through a gap it is what a ray
+    meets past the gap's own faces (those are wall); behind a solid wall (a measured room's
+    virtual entry) the wall hides it. Never drawn in colour."""
+    door, w, d, m = room.door, room.width, room.depth, DOOR_MARGIN
+    a0, a1 = door.center - door.width / 2 - m, door.center + door.width / 2 + m
+    z0, z1 = door.bottom - m, door.top + m
+    if door.wall in ("south", "north"):
+        y = -DOOR_BEHIND if door.wall == "south" else d + DOOR_BEHIND
+        corners = [(a0, y, z0), (a1, y, z0), (a1, y, z1), (a0, y, z1)]
+    else:
+        x = -DOOR_BEHIND if door.wall == "west" else w + DOOR_BEHIND
+        corners = [(x, a0, z0), (x, a1, z0), (x, a1, z1), (x, a0, z1)]
+    faces = np.array([[0, 1, 2], [0, 2, 3]], np.int32)
+    return MeshData(np.array(corners, np.float64), faces, np.zeros((2, 3), np.float32), "door")
 
 
 # ---------------------------------------------------------------------------------- reading

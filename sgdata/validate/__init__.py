@@ -13,7 +13,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from sgdata.dataset.schema import FORMAT_VERSION, _parse_version
+from sgdata.dataset.schema import FORMAT_VERSION, parse_version
 from sgdata.validate.appearance_checks import check_appearance
 from sgdata.validate.channel_checks import CHANNEL_CHECKS, check_channels
 from sgdata.validate.composition_checks import (
@@ -99,7 +99,7 @@ def _check_contents(root: Path, raw: dict, out: Collector, *, quick: bool, usd: 
     check_splits(raw, out)
     check_files(root, raw, out)
     check_metadata(root, raw, out)
-    newer = _parse_version(raw["format_version"])[:2] > _parse_version(FORMAT_VERSION)[:2]
+    newer = parse_version(raw["format_version"])[:2] > parse_version(FORMAT_VERSION)[:2]
     splits = []
     for split in raw["splits"]:
         tables = load_split(root, raw, split, out, extra_ok=newer)

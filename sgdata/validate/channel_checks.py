@@ -1,11 +1,13 @@
-"""Channel checks: the optional ``depth`` and ``instances`` PNGs of each row agree with the row.
+"""Channel checks: the optional ``depth``, ``instances`` and ``structure`` PNGs of each row
+agree with the row.
 
 - ``channels.present``: a synthetic row has each channel its config's ``[outputs]`` turned on;
 - ``channels.decode``: a channel cell is a 16-bit greyscale PNG;
 - ``channels.size``: of the row's camera size;
 - ``masks.extent``: each listed object's mask pixels span exactly its stored 2D box (+-1 px);
 - ``masks.unlisted``: no mask pixel names an object the row does not list;
-- ``depth.hits``: depth is positive wherever the mask sees an object;
+- ``masks.structure``: the structure mask names a known part, and none where an object is seen;
+- ``depth.hits``: depth is positive wherever the masks see an object, a wall, floor or ceiling;
 - ``depth.range``: no depth beyond the room's diagonal (the room read from the row's scene).
 
 The decoding is the slow part, so ``quick`` validation skips these checks as it skips images.
@@ -24,6 +26,7 @@ import pyarrow.parquet as pq
 from sgdata.dataset.channels import (
     CHANNELS,
     DEPTH_UNITS_PER_METRE,
+    STRUCTURE_PARTS,
     decode_channel,
     stored_channels,
 )
@@ -40,6 +43,7 @@ CHANNEL_CHECKS = (
     "channels.size",
     "masks.extent",
     "masks.unlisted",
+    "masks.structure",
     "depth.hits",
     "depth.range",
 )
@@ -89,10 +93,18 @@ def inspect_channels(
                     f"mask values {extra[:5].tolist()} name objects beyond the {len(boxes)} listed",
                 )
             )
-    if depth is not None and mask is not None:
-        holes = int(np.count_nonzero((mask > 0) & (depth == 0)))
+    parts = arrays.get("structure")
+    if parts is not None:
+        out.extend(("masks.structure", "structure", m) for m in _structure_problems(parts, mask))
+    if depth is not None and (mask is not None or parts is not None):
+        seen = np.zeros(depth.shape, bool)
+        if mask is not None:
+            seen |= mask > 0
+        if parts is not None:  # the door's opening has no surface, so no depth
+            seen |= (parts > 0) & (parts < STRUCTURE_PARTS.index("door") + 1)
+        holes = int(np.count_nonzero(seen & (depth == 0)))
         if holes:
-            out.append(("depth.hits", "depth", f"depth 0 at {holes} pixel(s) the mask sees"))
+            out.append(("depth.hits", "depth", f"depth 0 at {holes} pixel(s) the masks see"))
     if depth is not None and diagonal is not None:
         deepest = int(depth.max(initial=0)) / DEPTH_UNITS_PER_METRE
         if deepest > diagonal + 1.0 / DEPTH_UNITS_PER_METRE:
@@ -103,6 +115,20 @@ def inspect_channels(
                     f"depth {deepest:.3f} m beyond the room's diagonal {diagonal:.3f} m",
                 )
             )
+    return out
+
+
+def _structure_problems(parts: np.ndarray, mask: np.ndarray | None) -> list[str]:
+    """A structure mask's values beyond the known parts, or set where an object is seen."""
+    out = []
+    if int(parts.max(initial=0)) > len(STRUCTURE_PARTS):
+        extra = np.unique(parts[parts > len(STRUCTURE_PARTS)])
+        known = ", ".join(f"{k} {p}" for k, p in enumerate(STRUCTURE_PARTS, start=1))
+        out.append(f"structure values {extra[:5].tolist()}; expected 0 or {known}")
+    if mask is not None:
+        both = int(np.count_nonzero((mask > 0) & (parts > 0)))
+        if both:
+            out.append(f"{both} pixel(s) hold both an object and a structure part")
     return out
 
 
@@ -134,7 +160,7 @@ def _extent_problems(mask: np.ndarray, boxes: np.ndarray) -> list[str]:
 
 def check_channels(root: Path, raw: dict[str, Any], files: list[str], out: Collector) -> None:
     """Decode the channels of the given observation shards and check them against the rows."""
-    wanted = stored_channels(raw.get("config"))
+    wanted = stored_channels(raw.get("config"), raw["format_version"])
     expected = observations_schema()
     diagonals: dict[str, float | None] = {}
     for rel in files:

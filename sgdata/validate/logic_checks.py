@@ -10,7 +10,7 @@ import numpy as np
 
 from sgdata.dataset.camera import CAMERA_SINCE, camera_columns
 from sgdata.dataset.paths import MANIFEST
-from sgdata.dataset.schema import _parse_version as _version
+from sgdata.dataset.schema import parse_version as _version
 from sgdata.validate.loading import Flat, SplitTables, column_numpy, flatten_list
 from sgdata.validate.problems import Collector
 

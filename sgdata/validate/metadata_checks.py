@@ -11,7 +11,7 @@ from sgdata.dataset.card import front_matter, read_front_matter
 from sgdata.dataset.croissant import croissant_dict
 from sgdata.dataset.manifest import META_SINCE, Manifest
 from sgdata.dataset.paths import CARD, CROISSANT, MANIFEST
-from sgdata.dataset.schema import _parse_version
+from sgdata.dataset.schema import parse_version
 from sgdata.errors import DatasetError
 from sgdata.validate.problems import Collector
 
@@ -88,7 +88,7 @@ def _check_croissant(root: Path, manifest: Manifest, out: Collector) -> None:
 def check_metadata(root: Path, raw: dict[str, Any], out: Collector) -> None:
     """The card's front matter and ``croissant.json`` against the manifest (format 2.0.0 on;
     an older dataset has neither, and these checks are skipped)."""
-    if _parse_version(raw["format_version"]) < _parse_version(META_SINCE):
+    if parse_version(raw["format_version"]) < parse_version(META_SINCE):
         out.skipped.extend([CARD_CHECK, CROISSANT_CHECK])
         return
     try:

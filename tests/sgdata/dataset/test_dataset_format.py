@@ -440,12 +440,15 @@ def test_newer_minor_drops_unknown_keys() -> None:
 
 
 def with_channels(record: ViewRecord) -> ViewRecord:
-    """``record`` with a depth map and an instance mask (each object fills its 2D box)."""
+    """``record`` with a depth map, an instance mask (each object fills its 2D box) and a
+    structure mask (the rest is wall, the bottom row floor)."""
     instances = np.zeros((record.image_height, record.image_width), np.uint16)
     for k, (x0, y0, x1, y1) in enumerate(record.obj_box2d, start=1):
         instances[y0 : y1 + 1, x0 : x1 + 1] = k
     depth = np.where(instances > 0, 1.5, 0.0).astype(np.float32)
-    return dataclasses.replace(record, depth=depth, instances=instances)
+    structure = np.where(instances > 0, 0, 1).astype(np.uint8)
+    structure[-1][instances[-1] == 0] = 2
+    return dataclasses.replace(record, depth=depth, instances=instances, structure=structure)
 
 
 def build_tiny_dataset(root: Path) -> Path:

@@ -90,6 +90,27 @@ def _too_deep(depth: np.ndarray, row: dict) -> bytes:
     return encode_mask(out)
 
 
+def _part_on_object(parts: np.ndarray, row: dict) -> bytes:
+    out = parts.copy()
+    u1, v1, u2, v2 = row["objects"][0]["box2d"]
+    out[v1:v2, u1:u2] = 1  # a wall painted over the first object
+    return encode_mask(out)
+
+
+def _unknown_part(parts: np.ndarray, row: dict) -> bytes:
+    out = parts.copy()
+    out[parts > 0] = 9
+    return encode_mask(out)
+
+
+def _floor_without_depth(depth: np.ndarray, row: dict) -> bytes:
+    from sgdata.dataset.channels import depth_metres, encode_depth
+
+    metres = depth_metres(depth)
+    metres[-1, :] = 0.0  # the bottom row sees the floor (or an object) in these views
+    return encode_depth(metres)
+
+
 def _wrong_size(values: np.ndarray, row: dict) -> bytes:
     return encode_mask(values[::2, ::2].copy())
 
@@ -110,6 +131,10 @@ def _eight_bit(values: np.ndarray, row: dict) -> bytes:
         ("instances", _wrong_size, "channels.size"),
         ("depth", _eight_bit, "channels.decode"),
         ("depth", lambda values, row: None, "channels.present"),
+        ("structure", _part_on_object, "masks.structure"),
+        ("structure", _unknown_part, "masks.structure"),
+        ("depth", _floor_without_depth, "depth.hits"),
+        ("structure", lambda values, row: None, "channels.present"),
     ],
 )
 def test_damaged_channel_is_named(copy: Path, column: str, change: Callable, check: str) -> None:
@@ -118,5 +143,7 @@ def test_damaged_channel_is_named(copy: Path, column: str, change: Callable, che
     found = [p for p in report.problems if p.check == check]
     assert found, sorted({p.check for p in report.problems})
     assert {(p.file, p.row, p.field) for p in found} == {(SHARD, row, column)}
-    # nothing else broke (a mask pixel painted where nothing is drawn also has no depth)
-    assert {p.check for p in report.problems} <= {check, "masks.extent", "depth.hits"}
+    # nothing else broke (a mask pixel painted where nothing is drawn also has no depth, one
+    # painted on the room also overlaps its structure mask)
+    also = {"masks.extent", "depth.hits", "masks.structure"}
+    assert {p.check for p in report.problems} <= {check, *also}

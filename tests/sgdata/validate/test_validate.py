@@ -17,7 +17,7 @@ import pytest
 from PIL import Image
 
 from sgdata.dataset import Dataset, read_manifest, write_manifest, write_parquet
-from sgdata.dataset.schema import file_schema, observations_schema, schema_at
+from sgdata.dataset.schema import file_schema, observations_schema, parse_version, schema_at
 from sgdata.errors import DatasetError
 from sgdata.validate import ValidationReport, validate_dataset
 
@@ -75,12 +75,12 @@ def legacy_dataset(
     root: Path, *, drop: tuple[str, ...] | list[str] = (), version: str = "1.1.0"
 ) -> None:
     """Turn a generated dataset into one of an older format, as that sgdata wrote it: without
-    the columns later minors added, PNGs
-    deflated the old way, its own ``format_version`` in each table's metadata and, for 1.x,
-    images as bare bytes (non-null binary, no huggingface metadata), no card, no
-    croissant.json."""
+    the columns later minors added, PNGs deflated the old way (before 2.0.1), its own
+    ``format_version`` in each table's metadata and, for 1.x, images as bare bytes (non-null
+    binary, no huggingface metadata), no card, no croissant.json."""
     raw = json.loads((root / "dataset.json").read_text())
     bare = version.startswith("1.")
+    old_png = parse_version(version) < parse_version("2.0.1")
     files = []
     for entry in raw["files"]:
         path = root / entry["path"]
@@ -100,7 +100,8 @@ def legacy_dataset(
             table = table.drop_columns([n for n in table.column_names if n not in known])
             at = table.schema.get_field_index("image")
             old = [
-                {"bytes": deflated_the_old_way(cell["bytes"]), "path": None}
+                {"bytes": deflated_the_old_way(cell["bytes"]) if old_png else cell["bytes"]}
+                | {"path": None}
                 for cell in table.column("image").to_pylist()
             ]
             column = pa.array(old, type=table.schema.field(at).type)
@@ -472,6 +473,29 @@ def test_a_format_2_0_0_dataset_migrates_to_the_bytes_generate_writes(
             assert stamp == FORMAT_VERSION.encode(), entry.path
     generated = {f.path: f.sha256 for f in Dataset.open(mini_dataset).manifest.files}
     assert {f.path: f.sha256 for f in read_manifest(copy).files} == generated
+
+
+def test_a_format_2_2_dataset_with_masks_migrates_to_the_structure_generate_draws(
+    channels_dataset: Path, tmp_path: Path
+) -> None:
+    """2.3.0's structure mask is drawn again from each view's scene layer: the very bytes;
+    without a renderer to draw it, migrate refuses before it writes anything."""
+    from sgdata.dataset import FORMAT_VERSION, migrate_dataset
+    from sgdata.pipeline.structure_masks import structure_column
+
+    old = tmp_path / "old"
+    shutil.copytree(channels_dataset, old)
+    legacy_dataset(old, version="2.2.0")
+    assert "structure" not in pq.read_schema(old / SHARD).names
+    report = validate_dataset(old)
+    assert report.ok, report.problems[:3]
+    before = {p: p.read_bytes() for p in old.rglob("*") if p.is_file()}
+    with pytest.raises(DatasetError, match="structure masks drawn from the scene layers"):
+        migrate_dataset(old)
+    assert {p: p.read_bytes() for p in old.rglob("*") if p.is_file()} == before
+    assert migrate_dataset(old, draw_structure=structure_column).format_version == FORMAT_VERSION
+    generated = {f.path: f.sha256 for f in read_manifest(channels_dataset).files}
+    assert {f.path: f.sha256 for f in read_manifest(old).files} == generated
 
 
 def test_migrating_a_png_that_does_not_decode_names_the_file(copy: Path) -> None:
