@@ -546,6 +546,17 @@ def benchmark(
         int, typer.Option(help="Navigation episodes per case (N, A) and room.")
     ] = NAVIGATION_TEST.episodes,
     workers: Annotated[int, typer.Option(help="Navigation worker processes.")] = 1,
+    stop_policy: Annotated[
+        bool,
+        typer.Option(
+            "--stop-policy",
+            help="With --navigator: also choose each method's stop rule on val episodes for "
+            "navigation success and give its test row beside the paper's rule.",
+        ),
+    ] = False,
+    val_episodes: Annotated[
+        int, typer.Option(help="--stop-policy: val episodes per case and room to choose on.")
+    ] = STOP_POLICY_VAL_EPISODES,
     covisibility: Annotated[
         bool,
         typer.Option(
@@ -572,13 +583,17 @@ def benchmark(
         )  # fmt: skip
     except ValueError:
         raise typer.BadParameter("--seeds takes integers, --lrs numbers, comma-separated") from None
+    if stop_policy and navigator is None:
+        from seannet.errors import NavigationError
+
+        raise NavigationError("--stop-policy chooses a stop rule for --navigator: give one")
     dataset = open_dataset(data)  # every method's seeds, saved method, card and test share it
     navigation = None
     if navigator is not None:
         test = NavigationTestConfig(episodes=episodes)
-        navigation = partial(
-            navigation_test, navigator=navigator, data=dataset, config=test, workers=workers
-        )
+        navigation = partial(navigation_test, navigator=navigator, data=dataset, config=test,
+                             workers=workers, stop_policy=stop_policy,
+                             val_episodes=val_episodes)  # fmt: skip
     oracle = None
     if covisibility:
         from seannet.evaluation.covisibility_oracle import oracle as covisibility_oracle

@@ -232,11 +232,18 @@ def _covisibility_lines(c: dict[str, Any]) -> list[str]:
 
 def _navigation_lines(nav: dict[str, Any]) -> list[str]:
     """The navigation test's rates per rule and case, % with the 95 % interval by rooms."""
+    chosen = nav.get("stop_rule")
+    how = (
+        f"; `chosen`: the stop rule chosen on {chosen['val_episodes']} val episodes per case and "
+        f"room for navigation success, {chosen['label']}"
+        if chosen
+        else ""
+    )
     lines = [
         "",
         f"Navigation test with this method as localizer ({nav['split']} rooms, "
         f"{nav['episodes_per_case_and_room']} episodes per case and room, navigator "
-        f"`{Path(nav['navigator']).name}`, epsilon {nav['epsilon']:.3f} from val; % [95 % "
+        f"`{Path(nav['navigator']).name}`, epsilon {nav['epsilon']:.3f} from val{how}; % [95 % "
         f"interval by rooms]; [{nav['results']}]({nav['results']})):",
         "",
     ]
@@ -254,12 +261,17 @@ def _rate(rate: dict[str, float]) -> str:
 
 
 def _navigation_cell(card: dict[str, Any]) -> str:
-    """Success % N / A under the paper's rule, or "-" without a navigation test."""
+    """Success % N / A under the paper's rule, and under the chosen stop rule where the card
+    has one; "-" without a navigation test."""
     nav = card["summary"].get("navigation")
     if not nav:
         return "-"
-    paper = nav["rates"]["paper"]
-    return " / ".join(f"{paper[c]['success']['percent']:.1f}" for c in paper)
+    cells = []
+    for rule in ("paper", "chosen"):
+        if rule in nav["rates"]:
+            rates = nav["rates"][rule]
+            cells.append(" / ".join(f"{rates[c]['success']['percent']:.1f}" for c in rates))
+    return " · chosen ".join(cells)
 
 
 def _plot(card: dict[str, Any]) -> Image.Image:

@@ -24,6 +24,8 @@ from seannet.navigation.navigator import NavigatorConfig
 from seannet.navigation.navigator_training import train_navigator
 from sgdata.dataset import Dataset
 
+from ...cli_runner import run_cli
+
 ONE_EPISODE = NavigationTestConfig(episodes=1)
 
 
@@ -52,6 +54,11 @@ def test_what_names_a_localizer_and_the_one_line_refusals(
     named = open_localizer("tiny-image", mini_dataset, epsilon=0.9)
     assert isinstance(named, MethodLocalizer) and named.source == "tiny-image"
     assert named.epsilon == 0.9 and named.epsilon_source == "--epsilon"
+    done = run_cli("seannet", "benchmark", "--data", mini_dataset, "--methods", "tiny-image",
+                   "--out", tmp_path / "cards", "--stop-policy")  # fmt: skip
+    assert done.returncode != 0 and len(done.stderr.strip().splitlines()) == 1
+    assert "--stop-policy chooses a stop rule for --navigator" in done.stderr
+    assert not (tmp_path / "cards").exists()
     assert run_labels(["tiny-image", "examples/custom_method.py:ColourBoxes", tmp_path]) == [
         "tiny-image",
         "custom_method.py__ColourBoxes",
@@ -110,20 +117,27 @@ def test_a_method_by_name_navigates(mini_dataset: Path, navigator: Path, tmp_pat
 def test_benchmark_with_a_navigator_puts_the_rates_in_the_card(
     mini_dataset: Path, navigator: Path, tmp_path: Path
 ) -> None:
+    """With --stop-policy the card (and the leaderboard) gives the stop rule chosen on val
+    beside the paper's rule, both judged on the same test episodes."""
     config = BenchmarkConfig(seeds=(0,), batch_size=16, noise=())
-    test = partial(navigation_test, navigator=navigator, data=mini_dataset, config=ONE_EPISODE)
+    test = partial(navigation_test, navigator=navigator, data=mini_dataset, config=ONE_EPISODE,
+                   stop_policy=True, val_episodes=1)  # fmt: skip
     card_file = benchmark_method(
         "boxes-kernel", mini_dataset, tmp_path / "cards", config, navigation=test
     )
     directory = card_file.parent
     card = json.loads(card_file.read_text())
     nav = card["summary"]["navigation"]
-    paper = nav["rates"]["paper"]
-    assert set(paper) == {"N", "A"}
-    for case in paper.values():
-        assert case["episodes"] >= 1
-        shares = [case[k]["percent"] for k in ("success", "localization", "navigation")]
-        assert sum(shares) + case["collision"]["percent"] == pytest.approx(100.0)
+    assert set(nav["rates"]) == {"paper", "chosen"} and nav["stop_rule"]["val_episodes"] == 1
+    for rule in nav["rates"].values():
+        assert set(rule) == {"N", "A"}
+        for case in rule.values():
+            assert case["episodes"] >= 1
+            shares = [case[k]["percent"] for k in ("success", "localization", "navigation")]
+            assert sum(shares) + case["collision"]["percent"] == pytest.approx(100.0)
+    policy = json.loads((directory / "navigation" / "stop_policy.json").read_text())
+    assert policy["runs"][0]["choice"]["label"] == nav["stop_rule"]["label"]
+    assert policy["val"]["split"] == "val" and policy["test"]["split"] == "test"
     assert nav["epsilon"] == pytest.approx(card["runs"][0]["threshold"]["epsilon"])
     assert "Navigation test with this method as localizer" in (directory / "card.md").read_text()
     assert (directory / nav["results"]).is_file()
@@ -135,3 +149,5 @@ def test_benchmark_with_a_navigator_puts_the_rates_in_the_card(
     assert opened.method.scene.kernel is not None  # the kernel fit on train, not a fresh method
     board = leaderboard(read_cards([tmp_path / "cards"]))
     assert "navigation success % N / A" in board
+    chosen = nav["rates"]["chosen"]
+    assert f"chosen {chosen['N']['success']['percent']:.1f} / " in board
