@@ -3,12 +3,18 @@
     .venv/bin/python bench/generate.py                 # 1 vs 2 workers, 2 / 4 / 8 rooms
     .venv/bin/python bench/generate.py --rooms 2 4 8 16
     .venv/bin/python bench/generate.py --preset medium --workers 8 16   # a preset, whole
+    .venv/bin/python bench/generate.py --one 24 2 --profile   # one run, where its time went
 
 For each room count it runs a fresh process that generates a dataset of that many rooms
 (kitchens and bathrooms, 3 layouts, 24 triplets per room, 224 x 224) and prints views/s of
 the whole run and of the render phase, and the peak resident memory of the main process and
 of the largest worker. Peak worker memory must stay flat as rooms grow: each worker renders
 one room at a time and writes its shard before taking the next.
+
+With ``--profile`` the run is ``sgdata generate --profile``'s: its JSON line also holds the
+stage table (:func:`sgdata.pipeline.room_tasks.stage_order`: the command's wall time by step,
+then each task phase's worker time by stage, with the time outside the tasks). Profiling
+times every stage, so its views/s are not the plain run's.
 """
 
 from __future__ import annotations
@@ -42,11 +48,19 @@ test = 0
 """
 
 
-def run_one(rooms: int, workers: int, executor: str = "local", preset: str | None = None) -> dict:
+def run_one(
+    rooms: int,
+    workers: int,
+    executor: str = "local",
+    preset: str | None = None,
+    profile: bool = False,
+) -> dict:
     """Generate in this process (``preset`` whole, or ``rooms`` rooms of the bench config);
-    report counts, times and peak memory (MiB)."""
+    report counts, times and peak memory (MiB), and with ``profile`` the stage table."""
     from sgdata.pipeline.config import load_config
     from sgdata.pipeline.generate import generate_dataset
+    from sgdata.pipeline.room_tasks import stage_order
+    from sgdata.stage_clock import StageClock
 
     with tempfile.TemporaryDirectory() as tmp:
         config_path = Path(tmp) / "bench.toml"
@@ -58,6 +72,7 @@ def run_one(rooms: int, workers: int, executor: str = "local", preset: str | Non
             phases[step.phase] = step.elapsed
             phases[f"{step.phase}_views"] = step.views
 
+        clock = StageClock() if profile else None
         start = time.perf_counter()
         manifest = generate_dataset(
             config,
@@ -65,9 +80,11 @@ def run_one(rooms: int, workers: int, executor: str = "local", preset: str | Non
             workers=workers,
             executor=executor,
             progress=progress,
+            clock=clock,
         )
         wall = time.perf_counter() - start
     views = sum(manifest["counts"]["observations"].values())
+    stages = {"profile": clock.rows(stage_order())} if clock is not None else {}
     return {
         "rooms": sum(len(r) for r in manifest["splits"].values()),
         "workers": workers,
@@ -78,7 +95,7 @@ def run_one(rooms: int, workers: int, executor: str = "local", preset: str | Non
         "render_views_per_s": round(views / phases["views"], 2),
         "main_peak_mib": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1),
         "worker_peak_mib": round(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024, 1),
-    }
+    } | stages
 
 
 def main() -> None:
@@ -87,10 +104,12 @@ def main() -> None:
     parser.add_argument("--workers", type=int, nargs="+", default=[1, 2])
     parser.add_argument("--executor", default="local", choices=["local", "ray"])
     parser.add_argument("--preset", help="generate this preset whole (--rooms is then ignored)")
-    parser.add_argument("--one", nargs=2, type=int, help=argparse.SUPPRESS)  # rooms workers
+    parser.add_argument("--one", nargs=2, type=int, help="ROOMS WORKERS: one run, one JSON line")
+    parser.add_argument("--profile", action="store_true", help="with --one: the stage table")
     args = parser.parse_args()
     if args.one:
-        print(json.dumps(run_one(*args.one, executor=args.executor, preset=args.preset)))
+        one = run_one(*args.one, executor=args.executor, preset=args.preset, profile=args.profile)
+        print(json.dumps(one))
         return
     rows = []
     for rooms in [0] if args.preset else args.rooms:

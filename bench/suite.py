@@ -23,6 +23,9 @@ Measures:
 - generate: ``sgdata generate`` end to end on ``--rooms`` rooms with 1 and 2 local workers
   and with Ray (a local instance, 2 workers), each twice, interleaved: each one's fastest
   round, and how far its ratios move from round to round;
+- profile: where the time of ``sgdata generate`` goes, on the same ``--rooms`` with 1 and 2
+  local workers (``bench/generate.py --profile``): the command's wall time by step, each task
+  phase's worker time by stage and the time outside the tasks;
 - loader: ``bench/loader.py`` on a ``tiny`` dataset generated for the run;
 - validate: ``sgdata validate`` on a dataset (``--validate``, default that ``tiny`` one);
 - train: ``bench/train_step.py`` on that ``tiny`` one: each network docs/results.md trains,
@@ -64,7 +67,7 @@ PY = sys.executable
 PAGE = ROOT / "docs" / "benchmarks.md"
 # the hand-assembled page this generator replaced: its figures, each naming its commit
 OLDER = ROOT / "docs" / "benchmarks-2026-12-02.md"
-CORE = ("render", "generate", "loader", "validate", "train")
+CORE = ("render", "generate", "profile", "loader", "validate", "train")
 EXTRAS = ("channels", "assets", "fuzz", "tests")
 # the ratios the project holds itself to (issue 25): aims, not measurements
 AIMS = {
@@ -201,6 +204,32 @@ def _generate_section(runs: list[dict[str, Any]]) -> list[str]:
     return table(("run (each round's wall time)", "fastest round", "aim"), rows)
 
 
+def _profile_commands(args: argparse.Namespace, tiny: Path) -> list[list[str]]:
+    one = [PY, str(BENCH / "generate.py"), "--one", str(args.rooms)]
+    return [[*one, str(workers), "--profile"] for workers in (1, 2)]
+
+
+def _profile_section(runs: list[dict[str, Any]]) -> list[str]:
+    """One row per (phase, stage) of either run: seconds and share of its phase, 1 worker
+    beside 2; the command's rows are wall time, a task phase's are worker time."""
+    cells: dict[tuple[str, str], list[str]] = {}
+    for k, run in enumerate(runs):
+        for row in run["profile"]:
+            cell = f"{row['seconds']:.2f} s ({100 * row['share']:.1f} %)"
+            cells.setdefault((row["phase"], row["stage"]), ["", ""])[k] = cell
+    lines = [
+        f"{runs[0]['views']} views of {runs[0]['rooms']} rooms: {runs[0]['wall_s']} s with 1 "
+        f"worker, {runs[1]['wall_s']} s with 2 (profiled: every stage timed). Phase `command` "
+        "is the command's wall time by step (`scenes` and `views`: each task phase's wall); "
+        "phases `scenes` and `views` are their workers' time summed, by stage, with "
+        "`outside the tasks` what no task claimed (workers starting, idle while the last "
+        "rooms finish, results coming back).",
+        "",
+    ]
+    return lines + table(("phase", "stage", "1 worker", "2 workers"),
+                         ([p, s, *c] for (p, s), c in cells.items()))  # fmt: skip
+
+
 def _loader_commands(args: argparse.Namespace, tiny: Path) -> list[list[str]]:
     return [[PY, str(BENCH / "loader.py"), "--data", str(tiny)]]
 
@@ -330,6 +359,12 @@ MEASURES: dict[str, Measure] = {
         _generate_commands,
         lambda outs, _s, _c: [_last_json(o) for o in outs],
         _generate_section,
+    ),
+    "profile": Measure(
+        "Where the time of `sgdata generate` goes (`bench/generate.py --profile`)",
+        _profile_commands,
+        lambda outs, _s, _c: [_last_json(o) for o in outs],
+        _profile_section,
     ),
     "loader": Measure(
         "Training dataloader (`bench/loader.py`)",

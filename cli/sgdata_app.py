@@ -257,10 +257,11 @@ def generate(
 
 
 def _print_stages(clock) -> None:  # noqa: ANN001
-    """The stage table of a profiled run: seconds summed over its workers, share per phase."""
+    """The stage table of a profiled run: the command's wall time by step, then each task
+    phase's worker time (summed over its workers) by stage; share per phase."""
     from sgdata.pipeline.room_tasks import stage_order
 
-    table = Table(title="where the time went (summed over workers)")
+    table = Table(title="where the time went: the command's wall, then each phase's workers")
     for column in ("phase", "stage", "calls", "seconds", "share"):
         table.add_column(column, justify="left" if column in ("phase", "stage") else "right")
     for row in clock.rows(stage_order()):

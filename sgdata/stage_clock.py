@@ -82,6 +82,11 @@ class StageClock:
         """The clock as JSON-able data: ``{"phase/stage": [seconds, calls]}``."""
         return {f"{p}/{s}": [self.seconds[(p, s)], self.calls[(p, s)]] for p, s in self.seconds}
 
+    def book(self, phase: str, stage: str, seconds: float) -> None:
+        """Book ``seconds`` measured elsewhere to ``(phase, stage)`` as one call."""
+        self.seconds[(phase, stage)] += seconds
+        self.calls[(phase, stage)] += 1
+
     def add(self, totals: Mapping[str, list]) -> None:
         """Add another clock's :meth:`totals` (a worker's) to this one."""
         for key, (seconds, calls) in totals.items():

@@ -34,9 +34,9 @@ from sgdata.pipeline.ledger import (
     scene_record,
     views_record,
 )
-from sgdata.pipeline.room_tasks import RoomTask
+from sgdata.pipeline.room_tasks import COMMAND, OUTSIDE, SCENES, VIEWS, RoomTask
 from sgdata.seeds import split_triplets_seed
-from sgdata.stage_clock import StageClock
+from sgdata.stage_clock import NO_CLOCK, OTHER, StageClock
 from sgdata.world.room_recipes import ROOM_TYPES
 from sgdata.world.triplets import RoomPoses, Triplet, referenced_poses_by_room, sample_triplets
 
@@ -85,9 +85,12 @@ def generate_dataset(
 ) -> dict:
     """Generate the dataset described by ``config`` into ``root``; returns the manifest dict.
 
-    With a ``clock`` every room task times its stages (:func:`sgdata.pipeline.room_tasks.
-    stage_order`) on a clock of its own, added to ``clock`` as it finishes (``sgdata generate
-    --profile``); the bytes written are the same.
+    With a ``clock`` (``sgdata generate --profile``) the command times its own steps (phase
+    ``command``: inputs, each task phase's wall, triplets, manifest, and what none claims),
+    every room task times its stages (:func:`sgdata.pipeline.room_tasks.stage_order`) on a
+    clock of its own, added to ``clock`` as it finishes, and each task phase books the
+    worker time no task claimed (``outside the tasks``: workers x the phase's wall, less
+    the tasks' stages); the bytes written are the same.
 
     ``executor`` is ``local`` (spawned processes) or ``ray`` (``address`` joins a cluster,
     without it a local instance); the bytes written are the same whatever runs them.
@@ -109,19 +112,29 @@ def generate_dataset(
     """
     if workers < 1:
         raise ConfigError(f"--workers must be >= 1, got {workers}")
-    if config.catalog.files:  # the user's catalogs read, their meshes checked and hashed
+    timer = clock if clock is not None else NO_CLOCK
+    with timer.phase(COMMAND), timer.stage(OTHER):  # OTHER: what no step below claims
+        with timer.stage("inputs"):
+            config = _resolve_inputs(config)
+            _prepare_root(root, config, resume=resume, force=force)
+        with executor_session(executor, workers=workers, address=address):
+            engine = {"workers": workers, "executor": executor, "address": address}
+            return _generate(config, root, engine, progress, clock)
+
+
+def _resolve_inputs(config: GenerateConfig) -> GenerateConfig:
+    """The config with the user's catalogs (their meshes checked and hashed) and rooms
+    (checked and hashed before anything is written) resolved."""
+    if config.catalog.files:
         from sgdata.pipeline.user_assets import resolve_user_assets
 
         config = resolve_user_assets(config)
-    if config.rooms.files:  # checked and hashed before anything is written
+    if config.rooms.files:
         from sgdata.pipeline.user_rooms import resolve_user_rooms
 
         procedural = {t.room_id for t in plan_rooms(config) if not t.name}
         config = resolve_user_rooms(config, taken=procedural)
-    _prepare_root(root, config, resume=resume, force=force)
-    with executor_session(executor, workers=workers, address=address):
-        engine = {"workers": workers, "executor": executor, "address": address}
-        return _generate(config, root, engine, progress, clock)
+    return config
 
 
 def _generate(
@@ -131,20 +144,23 @@ def _generate(
     progress: Callable[[GenerateProgress], None] | None,
     clock: StageClock | None,
 ) -> dict:
+    timer = clock if clock is not None else NO_CLOCK
     tasks = plan_rooms(config)
     scene_jobs = [t for t in tasks if not scene_record(root, t.room_id).exists()]
-    _run_phase("scenes", scene_jobs, len(tasks), config, root, engine, progress, clock)
-    grids = {t.room_id: read_record(scene_record(root, t.room_id)) for t in tasks}
-
-    triplets = {split: _split_triplets(config, split, tasks, grids) for split in SPLITS}
-    poses = referenced_poses_by_room(t for split in SPLITS for t in triplets[split])
+    with timer.stage(SCENES):
+        _run_phase(SCENES, scene_jobs, len(tasks), config, root, engine, progress, clock)
+    with timer.stage("triplets"):
+        grids = {t.room_id: read_record(scene_record(root, t.room_id)) for t in tasks}
+        triplets = {split: _split_triplets(config, split, tasks, grids) for split in SPLITS}
+        poses = referenced_poses_by_room(t for split in SPLITS for t in triplets[split])
     view_jobs = [
         (t, poses.get(t.room_id, [])) for t in tasks if not views_record(root, t.room_id).exists()
     ]
-    _run_phase("views", view_jobs, len(tasks), config, root, engine, progress, clock)
-
-    shards = [read_record(views_record(root, t.room_id)) for t in tasks]
-    return _finish(root, config, tasks, shards, triplets)
+    with timer.stage(VIEWS):
+        _run_phase(VIEWS, view_jobs, len(tasks), config, root, engine, progress, clock)
+    with timer.stage("manifest"):
+        shards = [read_record(views_record(root, t.room_id)) for t in tasks]
+        return _finish(root, config, tasks, shards, triplets)
 
 
 def _finish(
@@ -278,19 +294,25 @@ def _run_phase(
     start = time.perf_counter()
     done = total - len(jobs)
     views = 0
-    if phase == "scenes":
+    if phase == SCENES:
         payloads = [(task, config, root, _task_clock(clock)) for task in jobs]
         fn = write_room_scenes
     else:
         payloads = [(task, list(poses), config, root, _task_clock(clock)) for task, poses in jobs]
         fn = render_room_views
+    booked = 0.0  # seconds the phase's tasks booked to their stages
     for result in run_tasks(fn, payloads, **engine):
         done += 1
         views += int(result.get("views", 0))
         if clock is not None:
-            clock.add(result.get("stages", {}))
+            stages = result.get("stages", {})
+            clock.add(stages)
+            booked += sum(seconds for seconds, _ in stages.values())
         if progress is not None:
             progress(GenerateProgress(phase, done, total, views, time.perf_counter() - start))
+    if clock is not None and jobs:  # the workers' time no task claimed
+        busy = min(engine["workers"], len(jobs)) * (time.perf_counter() - start)
+        clock.book(phase, OUTSIDE, max(0.0, busy - booked))
 
 
 def _task_clock(clock: StageClock | None) -> StageClock | None:

@@ -23,9 +23,22 @@ if TYPE_CHECKING:
     from sgdata.pipeline.config import GenerateConfig
     from sgdata.world.triplets import PoseKey
 
-__all__ = ["RoomTask", "render_room_views", "stage_order", "write_room_scenes"]
+__all__ = [
+    "COMMAND",
+    "OUTSIDE",
+    "RoomTask",
+    "render_room_views",
+    "stage_order",
+    "write_room_scenes",
+]
 
 SCENES, VIEWS = "scenes", "views"  # the phases of generate that run room tasks
+# The main process of generate: its own steps and the wall time of each task phase
+COMMAND = "command"
+COMMAND_STAGES = ("inputs", SCENES, "triplets", VIEWS, "manifest", OTHER)
+# A task phase's worker time that no task's stage claims: workers starting (spawn, imports,
+# EGL), idle while the last rooms finish, results coming back
+OUTSIDE = "outside the tasks"
 # The stages each task books to its clock, in pipeline order; the annotator's own steps come
 # in the views phase before "view record" (the rest of a view).
 SCENE_STAGES = ("catalog", "room", "room USD", "layouts", "USD read", "pose grid", "ledger", OTHER)
@@ -34,12 +47,14 @@ VIEW_TAIL = ("rows + image encode", "Parquet write", "ledger", OTHER)
 
 
 def stage_order() -> dict[str, tuple[str, ...]]:
-    """The phases of a profiled run and their stages in pipeline order (for its table)."""
+    """The phases of a profiled run and their stages in pipeline order (for its table): the
+    command's wall time, then each task phase's worker time."""
     from sgdata.annotate.annotator import VIEW_STEPS  # late: it loads the renderer
 
     return {
-        SCENES: SCENE_STAGES,
-        VIEWS: (*VIEW_STAGES[:-1], *VIEW_STEPS, VIEW_STAGES[-1], *VIEW_TAIL),
+        COMMAND: COMMAND_STAGES,
+        SCENES: (*SCENE_STAGES, OUTSIDE),
+        VIEWS: (*VIEW_STAGES[:-1], *VIEW_STEPS, VIEW_STAGES[-1], *VIEW_TAIL, OUTSIDE),
     }
 
 

@@ -36,6 +36,19 @@ def test_the_page_is_the_scripts_figures(tmp_path: Path, mini_dataset: Path) -> 
     settled = {**stamp, "settled_s": 54.0}  # it waited for the load to fall before it ran
     record = {"measure": "generate", "stamp": settled, "commands": [["x"]], "result": runs}
     (out / "generate.json").write_text(json.dumps(record))
+
+    # a profile record as bench/generate.py --profile prints it, 1 worker then 2
+    def profiled(wall: float, views: float, outside: float) -> dict:
+        rows = [{"phase": "command", "stage": "views", "calls": 1, "seconds": wall, "share": 0.9},
+                {"phase": "views", "stage": "render", "calls": 70, "seconds": views, "share": 0.5},
+                {"phase": "views", "stage": "outside the tasks", "calls": 1, "seconds": outside,
+                 "share": 0.25}]  # fmt: skip
+        return {"views": 70, "rooms": 2, "wall_s": wall, "profile": rows}
+
+    profile = [profiled(7.0, 3.5, 1.75), profiled(4.0, 3.0, 2.0)]
+    (out / "profile.json").write_text(
+        json.dumps({"measure": "profile", "stamp": stamp, "commands": [["x"]], "result": profile})
+    )
     # a train record as bench/train_step.py --json prints it: its rows, as measured
     steps = {
         "budget_s": 1200.0, "batch_size": 16, "epochs": 5, "clock": "thread-cpu, 1 torch thread",
@@ -66,6 +79,9 @@ def test_the_page_is_the_scripts_figures(tmp_path: Path, mini_dataset: Path) -> 
     assert "| **2 workers / 1** | 2.00x (rounds 2.00x to 2.00x) | >= 1.8x |" in doc
     assert "| **Ray local / local pool** | 1.00x (rounds 0.88x to 1.25x) | >= 0.8x |" in doc
     assert "| `seannet` | 4.250 | 1.70x | 31 % | 0 % | 56 |" in doc
+    assert "| views | render | 3.50 s (50.0 %) | 3.00 s (50.0 %) |" in doc
+    assert "| views | outside the tasks | 1.75 s (25.0 %) | 2.00 s (25.0 %) |" in doc
+    assert "70 views of 2 rooms: 7.0 s with 1 worker, 4.0 s with 2" in doc
     assert "batches per epoch 1200 s buy each over 5 epochs" in doc
     # what was not measured is listed with its command; the older page is fingerprinted
     assert "## Not measured in this set" in doc

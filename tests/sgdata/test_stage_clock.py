@@ -32,6 +32,9 @@ def test_a_workers_clock_travels_and_adds_up() -> None:
     main.add(worker.totals())
     assert main.calls[("scenes", "room")] == 2
     assert main.seconds[("scenes", "room")] == 2 * worker.seconds[("scenes", "room")]
+    main.book("scenes", "outside the tasks", 1.5)  # measured by the caller, not a block
+    assert main.calls[("scenes", "outside the tasks")] == 1
+    assert main.seconds[("scenes", "outside the tasks")] == 1.5
 
 
 def test_no_clock_times_nothing() -> None:

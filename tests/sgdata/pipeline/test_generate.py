@@ -20,7 +20,7 @@ from sgdata.dataset import Dataset
 from sgdata.errors import ConfigError, DatasetError
 from sgdata.pipeline.config import load_config
 from sgdata.pipeline.generate import LEDGER, generate_dataset
-from sgdata.pipeline.room_tasks import stage_order
+from sgdata.pipeline.room_tasks import COMMAND, OUTSIDE, stage_order
 from sgdata.stage_clock import StageClock
 from sgdata.world.triplets import tier_counts
 
@@ -47,6 +47,15 @@ def test_neither_worker_count_nor_profiling_changes_bytes(
     views = sum(pq.read_metadata(p).num_rows for p in (other / "observations").rglob("*.parquet"))
     assert rows[("views", "render")]["calls"] == views
     assert list(rows) == [k for k in rows if k[1] in stage_order()[k[0]]]  # known, in order
+    # the command's own steps, each once, the task phases' wall among them; with one worker
+    # a task phase's worker time (its tasks' stages and the time outside them) is its wall
+    steps = {s: r for (p, s), r in rows.items() if p == COMMAND}
+    assert set(steps) == {"inputs", "scenes", "triplets", "views", "manifest", "other"}
+    assert all(r["calls"] == 1 for r in steps.values())
+    for phase in ("scenes", "views"):
+        worker = sum(r["seconds"] for (p, _), r in rows.items() if p == phase)
+        assert rows[(phase, OUTSIDE)]["seconds"] >= 0
+        assert worker == pytest.approx(steps[phase]["seconds"], rel=0.05, abs=0.05)
 
 
 def test_composition_and_offsets(mini_triplets: dict[str, int], mini_dataset: Path) -> None:
