@@ -34,6 +34,9 @@ app = typer.Typer(
 console = Console()
 
 Data = Annotated[Path, typer.Option("--data", help="Dataset root (made by sgdata generate).")]
+ValEpisodes = Annotated[
+    int, typer.Option(help="--stop-policy: val episodes per case and room to choose on.")
+]
 # the defaults of the navigator and of the navigation test: their config dataclasses'
 NAVIGATOR = NavigatorConfig()
 NAVIGATION_TEST = NavigationTestConfig()
@@ -432,9 +435,7 @@ def navigate(
             "then judge the test episodes by it and by the paper's rule.",
         ),
     ] = False,
-    val_episodes: Annotated[
-        int, typer.Option(help="--stop-policy: val episodes per case and room to choose on.")
-    ] = STOP_POLICY_VAL_EPISODES,
+    val_episodes: ValEpisodes = STOP_POLICY_VAL_EPISODES,
     map_memory: Annotated[
         str,
         typer.Option(
@@ -554,9 +555,7 @@ def benchmark(
             "navigation success and give its test row beside the paper's rule.",
         ),
     ] = False,
-    val_episodes: Annotated[
-        int, typer.Option(help="--stop-policy: val episodes per case and room to choose on.")
-    ] = STOP_POLICY_VAL_EPISODES,
+    val_episodes: ValEpisodes = STOP_POLICY_VAL_EPISODES,
     covisibility: Annotated[
         bool,
         typer.Option(
