@@ -582,10 +582,13 @@ def benchmark(
         )  # fmt: skip
     except ValueError:
         raise typer.BadParameter("--seeds takes integers, --lrs numbers, comma-separated") from None
-    if stop_policy and navigator is None:
+    if stop_policy:  # refused before any method trains
         from seannet.errors import NavigationError
+        from seannet.navigation.stop_policy import check_val_episodes
 
-        raise NavigationError("--stop-policy chooses a stop rule for --navigator: give one")
+        if navigator is None:
+            raise NavigationError("--stop-policy chooses a stop rule for --navigator: give one")
+        check_val_episodes(val_episodes)
     dataset = open_dataset(data)  # every method's seeds, saved method, card and test share it
     navigation = None
     if navigator is not None:

@@ -32,7 +32,7 @@ from seannet.navigation.tables import INTERVAL, RATE_HEADER, SPLIT_HEADER, case_
 from seannet.provenance import append_provenance, stamp
 from sgdata.fileio import atomic_write_text
 
-__all__ = ["STOP_POLICY", "choose_and_test", "stop_policy_markdown"]
+__all__ = ["STOP_POLICY", "check_val_episodes", "choose_and_test", "stop_policy_markdown"]
 
 STOP_POLICY = "stop_policy.json"  # with stop_policy.md beside it
 
@@ -67,8 +67,7 @@ def choose_and_test(
         )
     if config.replan:
         raise NavigationError("--stop-policy judges episodes under the paper's rule: no --replan")
-    if val_episodes < 1:
-        raise NavigationError(f"--val-episodes {val_episodes}: expected >= 1 per case and room")
+    check_val_episodes(val_episodes)
     live_config = config.replace(map_memory=map_memory)  # checked before any episode runs
     ds = open_dataset(data)
     maps = out / "maps"
@@ -114,6 +113,16 @@ def choose_and_test(
     atomic_write_text(written, stop_policy_markdown(result))
     result["written"] = str(written)
     return result
+
+
+def check_val_episodes(val_episodes: int) -> None:
+    """Refuse a val episode count that can choose nothing (before anything runs).
+
+    Raises:
+        NavigationError: fewer than one episode per case and room.
+    """
+    if val_episodes < 1:
+        raise NavigationError(f"--val-episodes {val_episodes}: expected >= 1 per case and room")
 
 
 def _pct(share: float) -> str:

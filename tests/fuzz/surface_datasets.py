@@ -1,5 +1,6 @@
 """Surface: datasets on disk, randomly corrupted (manifest fields, Parquet bytes and columns,
-encoded images), read by ``Dataset.open`` and checked by ``validate``.
+encoded images and channels: depth, instance and structure masks), read by ``Dataset.open``
+and checked by ``validate``.
 
 Reading may refuse (a :class:`~sgdata.errors.DatasetError`); ``validate`` must report problems
 rather than raise; and neither may write anything into the dataset.
@@ -21,10 +22,11 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 from hypothesis import strategies as st
 
+from sgdata.dataset.channels import CHANNELS
 from sgdata.dataset.reader import Dataset, decode_image
 from sgdata.validate import validate_dataset
 
-from ..conftest import MINI_TOML
+from ..conftest import CHANNELS_TOML
 from .harness import Surface
 from .mutations import json_values
 
@@ -59,9 +61,10 @@ def generate_with_cli(root: Path, config_text: str) -> Path:
 
 
 @contextlib.contextmanager
-def mini_dataset(root: Path) -> Iterator[Path]:
-    """The tests' mini dataset (three bathrooms), generated once for a campaign by the CLI."""
-    yield generate_with_cli(root, MINI_TOML)
+def channels_dataset(root: Path) -> Iterator[Path]:
+    """The tests' mini dataset (three bathrooms) with its channels (depth, instance and
+    structure masks), generated once for a campaign by the CLI."""
+    yield generate_with_cli(root, CHANNELS_TOML)
 
 
 def _digest(root: Path) -> dict[str, str]:
@@ -126,20 +129,25 @@ def _corrupt_table(path: Path, k: int, edit: str, at: int) -> None:
 
 
 def _corrupt_image(path: Path, row: int, edit: str, at: int) -> None:
+    """Damage one encoded cell of an image column: the RGB or a channel, drawn by ``row``."""
     table = pq.read_table(path)
-    if "image" not in table.column_names or not len(table):
+    names = [n for n in ("image", *CHANNELS) if n in table.column_names]
+    if not names or not len(table):
         return
-    images = table.column("image").to_pylist()
+    name = names[row % len(names)]
+    images = table.column(name).to_pylist()
     k = row % len(images)
     stored = images[k]  # format 2: the Hugging Face Image struct; 1.x: the bytes
+    if stored is None:  # a channel this row does not store
+        return
     data = (stored.get("bytes") if isinstance(stored, dict) else stored) or b""
     at = at % max(len(data), 1)
     data = {"truncate": data[:at], "empty": b""}.get(
         edit, data[:at] + b"\x00garbage" + data[at + 8 :]
     )
     images[k] = {"bytes": data, "path": None} if isinstance(stored, dict) else data
-    index = table.schema.get_field_index("image")
-    table = table.set_column(index, "image", pa.array(images, table.schema.field("image").type))
+    index = table.schema.get_field_index(name)
+    table = table.set_column(index, name, pa.array(images, table.schema.field(name).type))
     pq.write_table(table, path)
 
 
@@ -177,5 +185,8 @@ def feed(example: list, work: Path, dataset: Path) -> None:
 
 
 SURFACE = Surface(
-    name="datasets (Dataset.open, validate)", inputs=corruptions, feed=feed, session=mini_dataset
+    name="datasets (Dataset.open, validate)",
+    inputs=corruptions,
+    feed=feed,
+    session=channels_dataset,
 )

@@ -17,7 +17,6 @@ from __future__ import annotations
 import contextlib
 import io
 import shutil
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -32,9 +31,8 @@ from sgdata.errors import SgdataError
 from sgdata.label.coco_export import export_coco
 from sgdata.label.yolo_export import export_yolo
 
-from ..conftest import CHANNELS_TOML
 from .harness import Surface
-from .surface_datasets import generate_with_cli
+from .surface_datasets import channels_dataset
 
 SPLIT = "val"
 ROWS = 3  # views of the split kept: the export's cost per example
@@ -76,12 +74,6 @@ views = st.fixed_dictionaries(
     }
 )
 examples = st.lists(views, min_size=1, max_size=3)
-
-
-@contextlib.contextmanager
-def channels_dataset(root: Path) -> Iterator[Path]:
-    """The tests' dataset with depth and instance masks, generated once for a campaign."""
-    yield generate_with_cli(root, CHANNELS_TOML)
 
 
 def _mask(spec: dict[str, Any], height: int, width: int, count: int) -> bytes | None:

@@ -28,7 +28,7 @@ EXAMPLES = {
 }
 # the surfaces whose examples edit copies of a dataset of the suite's (a session fixture)
 DATASETS = {
-    "datasets (Dataset.open, validate)": "mini_dataset",
+    "datasets (Dataset.open, validate)": "channels_dataset",
     "detector exports (COCO, YOLO)": "channels_dataset",
 }
 # A campaign (bench/fuzz.py) sets these: examples per surface, the hypothesis seed, the

@@ -59,6 +59,11 @@ def test_what_names_a_localizer_and_the_one_line_refusals(
     assert done.returncode != 0 and len(done.stderr.strip().splitlines()) == 1
     assert "--stop-policy chooses a stop rule for --navigator" in done.stderr
     assert not (tmp_path / "cards").exists()
+    done = run_cli("seannet", "benchmark", "--data", mini_dataset, "--methods", "tiny-image",
+                   "--out", tmp_path / "cards", "--navigator", tmp_path, "--stop-policy",
+                   "--val-episodes", "0")  # fmt: skip
+    assert done.returncode != 0 and len(done.stderr.strip().splitlines()) == 1
+    assert "--val-episodes 0: expected >= 1" in done.stderr and not (tmp_path / "cards").exists()
     assert run_labels(["tiny-image", "examples/custom_method.py:ColourBoxes", tmp_path]) == [
         "tiny-image",
         "custom_method.py__ColourBoxes",

@@ -9,14 +9,8 @@ from pathlib import Path
 import numpy as np
 
 from sgdata.dataset import Dataset
-from sgdata.dataset.channels import (
-    STRUCTURE_PARTS,
-    class_mask,
-    decode_channel,
-    stored_channels,
-)
-
-WALL, FLOOR, CEILING, DOOR = range(1, len(STRUCTURE_PARTS) + 1)
+from sgdata.dataset.channels import class_mask, decode_channel, stored_channels
+from sgdata.room_parts import DOOR, FLOOR, WALL
 
 
 def test_generated_views_name_the_rooms_parts(channels_dataset: Path) -> None:
