@@ -8,8 +8,9 @@
 For each room count it runs a fresh process that generates a dataset of that many rooms
 (kitchens and bathrooms, 3 layouts, 24 triplets per room, 224 x 224) and prints views/s of
 the whole run and of the render phase, and the peak resident memory of the main process and
-of the largest worker. Peak worker memory must stay flat as rooms grow: each worker renders
-one room at a time and writes its shard before taking the next.
+of the largest worker (of any phase; and of the rendering workers once 3 rooms were rendered
+and at the end). Peak worker memory must stay flat as rooms grow: each worker renders one
+room at a time and writes its shard before taking the next.
 
 With ``--profile`` the run is ``sgdata generate --profile``'s: its JSON line also holds the
 stage table (:func:`sgdata.pipeline.room_tasks.stage_order`: the command's wall time by step,
@@ -67,10 +68,13 @@ def run_one(
         config_path.write_text(CONFIG.format(per_type=rooms // 2, triplets=24 * rooms))
         config = load_config(preset or config_path)
         phases: dict[str, float] = {}
+        peaks: list[float] = []  # the views phase's worker peaks, room by room
 
         def progress(step) -> None:  # noqa: ANN001
             phases[step.phase] = step.elapsed
             phases[f"{step.phase}_views"] = step.views
+            if step.phase == "views":
+                peaks.append(step.worker_peak_mib)
 
         clock = StageClock() if profile else None
         start = time.perf_counter()
@@ -95,6 +99,9 @@ def run_one(
         "render_views_per_s": round(views / phases["views"], 2),
         "main_peak_mib": round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1),
         "worker_peak_mib": round(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024, 1),
+        # the largest worker's peak once 3 rooms were rendered, and once all were: flat if equal
+        "worker_peak_after_3_mib": round(max(peaks[:3]), 1),
+        "worker_peak_after_all_mib": round(max(peaks), 1),
     } | stages
 
 

@@ -22,7 +22,8 @@ Measures:
   textured;
 - generate: ``sgdata generate`` end to end on ``--rooms`` rooms with 1 and 2 local workers
   and with Ray (a local instance, 2 workers), each twice, interleaved: each one's fastest
-  round, and how far its ratios move from round to round;
+  round, its workers' peak memory, and how far its ratios move from round to round; and
+  1 worker against the render measure, run first in the same measure;
 - profile: where the time of ``sgdata generate`` goes, on the same ``--rooms`` with 1 and 2
   local workers (``bench/generate.py --profile``): the command's wall time by step, each task
   phase's worker time by stage and the time outside the tasks;
@@ -74,6 +75,7 @@ AIMS = {
     "textured: pipeline/naive": ">= 2x",
     "textured/flat": ">= 0.8x",
     "2 workers / 1": ">= 1.8x",
+    "1 worker / rendering alone": ">= 0.85x",
     "Ray local / local pool": ">= 0.8x",
     "channels / RGB only": ">= 0.85x",
     "meshes / procedural, annotated view": ">= 0.5x",
@@ -171,17 +173,25 @@ GENERATE_ROUNDS = 2  # each configuration twice, interleaved: one round's noise 
 
 
 def _generate_commands(args: argparse.Namespace, tiny: Path) -> list[list[str]]:
+    """The render measure first (the figure end to end is held to, in the same run), then
+    each configuration's rounds."""
     one = [PY, str(BENCH / "generate.py"), "--one", str(args.rooms)]
     return [
-        [*one, str(workers), "--executor", executor]
-        for _ in range(GENERATE_ROUNDS)
-        for _, workers, executor in GENERATE_RUNS
+        *_render_commands(args, tiny),
+        *(
+            [*one, str(workers), "--executor", executor]
+            for _ in range(GENERATE_ROUNDS)
+            for _, workers, executor in GENERATE_RUNS
+        ),
     ]
 
 
-def _generate_section(runs: list[dict[str, Any]]) -> list[str]:
-    """Each configuration's rounds and its fastest; the ratios of the fastest, with the range
-    of the same ratio round by round (how far one round's noise moves it)."""
+def _generate_section(result: dict[str, Any]) -> list[str]:
+    """Each configuration's rounds and its fastest, with its largest rendering worker's peak
+    memory once 3 rooms were rendered and at the end (flat when equal); the ratios of the
+    fastest, with the range of the same ratio round by round (how far one round's noise
+    moves it); 1 worker against the render measure's textured pipeline run just before."""
+    runs = result["runs"]
     n = len(GENERATE_RUNS)
     rounds = [runs[k::n] for k in range(n)]  # per configuration, its rounds in order
     best = [max(r["views_per_s"] for r in rs) for rs in rounds]
@@ -189,19 +199,37 @@ def _generate_section(runs: list[dict[str, Any]]) -> list[str]:
         (
             f"{label}: {rs[0]['views']} views in " + ", ".join(f"{r['wall_s']} s" for r in rs),
             f"{b:.2f} views/s",
+            " / ".join(
+                f"{max(r[k] for r in rs):.0f}"
+                for k in ("worker_peak_after_3_mib", "worker_peak_after_all_mib")
+            ),
             "",
         )
         for (label, _, _), rs, b in zip(GENERATE_RUNS, rounds, best, strict=True)
     ]
 
-    def ratio(name: str, over: int, under: int) -> tuple[str, str, str]:
+    def ratio(name: str, over: int, under: int) -> tuple[str, str, str, str]:
         pairs = zip(rounds[over], rounds[under], strict=True)
         each = [a["views_per_s"] / b["views_per_s"] for a, b in pairs]
         spread = f" (rounds {min(each):.2f}x to {max(each):.2f}x)" if len(each) > 1 else ""
-        return f"**{name}**", f"{best[over] / best[under]:.2f}x{spread}", AIMS[name]
+        return f"**{name}**", f"{best[over] / best[under]:.2f}x{spread}", "", AIMS[name]
 
-    rows += [ratio("2 workers / 1", 1, 0), ratio("Ray local / local pool", 2, 1)]
-    return table(("run (each round's wall time)", "fastest round", "aim"), rows)
+    rendered = result["render"]["pipeline_textured"]
+    alone = [r["views_per_s"] / rendered for r in rounds[0]]
+    rows += [
+        ratio("2 workers / 1", 1, 0),
+        ratio("Ray local / local pool", 2, 1),
+        (
+            f"**1 worker / rendering alone** (`bench/render.py` textured: {rendered:.1f} "
+            "annotated views/s)",
+            f"{best[0] / rendered:.2f}x (rounds {min(alone):.2f}x to {max(alone):.2f}x)",
+            "",
+            AIMS["1 worker / rendering alone"],
+        ),
+    ]
+    header = ("run (each round's wall time)", "fastest round",
+              "worker peak after 3 rooms / all (MiB)", "aim")  # fmt: skip
+    return table(header, rows)
 
 
 def _profile_commands(args: argparse.Namespace, tiny: Path) -> list[list[str]]:
@@ -357,8 +385,12 @@ MEASURES: dict[str, Measure] = {
     "generate": Measure(
         "`sgdata generate` end to end (`bench/generate.py`)",
         _generate_commands,
-        lambda outs, _s, _c: [_last_json(o) for o in outs],
+        lambda outs, _s, _c: {
+            "render": _last_json(outs[0]),
+            "runs": [_last_json(o) for o in outs[1:]],
+        },
         _generate_section,
+        env=_LP1,  # for the render measure it runs first; generate's workers set it anyway
     ),
     "profile": Measure(
         "Where the time of `sgdata generate` goes (`bench/generate.py --profile`)",

@@ -218,14 +218,13 @@ class LiveRooms:
 
 def _read_layout(data: Path, room_id: str, layout: int) -> tuple[Any, Any]:
     """(Room, SceneGeometry) of a layout's scene file."""
-    from sgdata.usd.geometry import read_geometry
-    from sgdata.usd.room_io import read_room
+    from sgdata.usd.room_io import read_scene
 
     path = layout_file(scene_dir(data, room_id), layout)
     if not path.is_file():
         raise DataError(f"{path}: no such layout of room {room_id!r} in {data}")
     try:
-        return read_room(path), read_geometry(path)
+        return read_scene(path)
     except SgdataError as exc:
         raise DataError(f"{path}: {exc}") from None
 

@@ -35,8 +35,10 @@ __all__ = [
     "IMAGE_FORMATS",
     "PNG_STRATEGY_SINCE",
     "PARQUET_OPTIONS",
+    "EncodedImages",
     "ParquetInfo",
     "encode_image",
+    "encode_view",
     "observation_table",
     "triplet_table",
     "write_parquet",
@@ -82,6 +84,32 @@ def encode_image(rgb: np.ndarray, image_format: str = "png", *, jpeg_quality: in
         # 4:2:0 subsampling and no progressive/optimize passes: fixed, widely decodable output.
         image.save(buffer, format="JPEG", quality=int(jpeg_quality), subsampling=2, optimize=False)
     return buffer.getvalue()
+
+
+class EncodedImages(NamedTuple):
+    """A view's image cells as stored: its encoded image, and its channels where kept."""
+
+    image: bytes
+    depth: bytes | None
+    instances: bytes | None
+    structure: bytes | None
+
+
+def encode_view(
+    rec: ViewRecord, image_format: str = "png", *, jpeg_quality: int = 92
+) -> EncodedImages:
+    """The image cells of one view (:func:`encode_image`, and 16-bit PNGs for its channels).
+
+    Raises:
+        DatasetError: inconsistent record columns or image shapes, an unknown image format.
+    """
+    _check_record(rec)
+    return EncodedImages(
+        image=encode_image(rec.rgb, image_format, jpeg_quality=jpeg_quality),
+        depth=None if rec.depth is None else encode_depth(rec.depth),
+        instances=None if rec.instances is None else encode_mask(rec.instances),
+        structure=None if rec.structure is None else encode_mask(rec.structure.astype(np.uint16)),
+    )
 
 
 def _check_record(rec: ViewRecord) -> int:
@@ -182,6 +210,7 @@ def observation_table(
     scene_paths: Sequence[str | None] | None = None,
     image_format: str = "png",
     jpeg_quality: int = 92,
+    encoded: Sequence[EncodedImages] | None = None,
 ) -> pa.Table:
     """Rows of ``observations_schema()`` for the rendered views of one room, in record order.
 
@@ -196,6 +225,8 @@ def observation_table(
             ``scene_path``); must have one entry per record.
         image_format: ``png`` (lossless, default) or ``jpeg``.
         jpeg_quality: JPEG quality, 1..100 (ignored for PNG).
+        encoded: the records' image cells already encoded (:func:`encode_view` with the same
+            format), one per record; the records' pixel arrays are then not read.
 
     Raises:
         DatasetError: inconsistent record columns, an unknown class or image format.
@@ -203,6 +234,10 @@ def observation_table(
     schema = observations_schema()
     counts = [_check_record(r) for r in records]
     n = len(records)
+    if encoded is None:
+        encoded = [encode_view(r, image_format, jpeg_quality=jpeg_quality) for r in records]
+    elif len(encoded) != n:
+        raise DatasetError(f"{len(encoded)} encoded views for {n} records; expected one each")
     ids = [obs_id(r.room_id, r.layout, r.grid_i, r.grid_j, r.heading) for r in records]
     cam_t = schema.field("camera").type
     camera = pa.StructArray.from_arrays(
@@ -238,10 +273,7 @@ def observation_table(
         "grid_j": pa.array([r.grid_j for r in records], type=pa.int16()),
         "heading": pa.array([r.heading for r in records], type=pa.int8()),
         "camera": camera,
-        "image": pa.array(
-            [encode_image(r.rgb, image_format, jpeg_quality=jpeg_quality) for r in records],
-            type=pa.binary(),
-        ),
+        "image": pa.array([e.image for e in encoded], type=pa.binary()),
         "image_format": pa.array([image_format] * n, type=pa.string()),
         "objects": _objects_column(records, counts, class_ids, schema.field("objects").type),
         "relations": _relations_column(records, schema.field("relations").type),
@@ -251,20 +283,9 @@ def observation_table(
         "textures": pa.array([r.textures for r in records], type=pa.bool_()),
         "light_intensity": pa.array([r.light_intensity for r in records], type=pa.float32()),
         "light_temperature": pa.array([r.light_temperature for r in records], type=pa.float32()),
-        "depth": pa.array(
-            [None if r.depth is None else encode_depth(r.depth) for r in records], pa.binary()
-        ),
-        "instances": pa.array(
-            [None if r.instances is None else encode_mask(r.instances) for r in records],
-            pa.binary(),
-        ),
-        "structure": pa.array(
-            [
-                None if r.structure is None else encode_mask(r.structure.astype(np.uint16))
-                for r in records
-            ],
-            pa.binary(),
-        ),
+        "depth": pa.array([e.depth for e in encoded], pa.binary()),
+        "instances": pa.array([e.instances for e in encoded], pa.binary()),
+        "structure": pa.array([e.structure for e in encoded], pa.binary()),
     }
     columns["intrinsics"], columns["camera_to_world"] = camera_columns(columns)
     return pa.Table.from_arrays([columns[f.name] for f in schema], schema=schema)

@@ -52,6 +52,8 @@ class GenerateProgress:
     total: int
     views: int  # views rendered so far in this run
     elapsed: float  # seconds since the phase started
+    # peak resident memory of the worker that ran the room just finished, so far (MiB)
+    worker_peak_mib: float = 0.0
 
 
 def plan_rooms(config: GenerateConfig) -> list[RoomTask]:
@@ -309,7 +311,9 @@ def _run_phase(
             clock.add(stages)
             booked += sum(seconds for seconds, _ in stages.values())
         if progress is not None:
-            progress(GenerateProgress(phase, done, total, views, time.perf_counter() - start))
+            peak = float(result.get("peak_rss_mib", 0.0))
+            elapsed = time.perf_counter() - start
+            progress(GenerateProgress(phase, done, total, views, elapsed, peak))
     if clock is not None and jobs:  # the workers' time no task claimed
         busy = min(engine["workers"], len(jobs)) * (time.perf_counter() - start)
         clock.book(phase, OUTSIDE, max(0.0, busy - booked))

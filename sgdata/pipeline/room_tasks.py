@@ -7,6 +7,7 @@ completion in the ledger last, so a task killed half-way leaves nothing that cou
 from __future__ import annotations
 
 import json
+import resource
 from collections import defaultdict
 from dataclasses import dataclass
 from pathlib import Path
@@ -27,6 +28,7 @@ __all__ = [
     "COMMAND",
     "OUTSIDE",
     "RoomTask",
+    "peak_rss_mib",
     "render_room_views",
     "stage_order",
     "write_room_scenes",
@@ -81,13 +83,16 @@ def write_room_scenes(
 ) -> dict:
     """Phase 1 of a room: USD room and layouts, and the reachable cells of every layout.
 
+    The result holds the views rendered (none here) and the worker's peak memory so far
+    (``peak_rss_mib``).
+
     With a ``clock`` (:class:`sgdata.stage_clock.StageClock`) its steps are timed as
     :func:`stage_order` and the result carries the clock's totals under ``"stages"``.
     """
     clock = clock or NO_CLOCK
     with clock.phase(SCENES), clock.stage(OTHER):
         _write_room_scenes(task, config, root, clock)
-    return {"views": 0, **_stages(clock)}
+    return {"views": 0, "peak_rss_mib": peak_rss_mib(), **_stages(clock)}
 
 
 def _write_room_scenes(task: RoomTask, config: GenerateConfig, root: Path, clock: Clock) -> None:
@@ -155,22 +160,24 @@ def render_room_views(
 ) -> dict:
     """Phase 3 of a room: render the referenced views and write the room's shard.
 
-    With a ``clock`` its steps are timed as :func:`stage_order` (the annotator's too) and the
-    result carries the clock's totals under ``"stages"``.
+    The result holds the views rendered and the worker's peak memory so far
+    (``peak_rss_mib``). With a ``clock`` its steps are timed as :func:`stage_order` (the
+    annotator's too) and the result carries the clock's totals under ``"stages"``.
     """
     clock = clock or NO_CLOCK
     with clock.phase(VIEWS), clock.stage(OTHER):
         views = _render_room_views(task, poses, config, root, clock)
-    return {"views": views, **_stages(clock)}
+    return {"views": views, "peak_rss_mib": peak_rss_mib(), **_stages(clock)}
 
 
 def _render_room_views(
     task: RoomTask, poses: list[PoseKey], config: GenerateConfig, root: Path, clock: Clock
 ) -> int:
     from sgdata.annotate.records import ViewPose
-    from sgdata.dataset.rows import observation_table, write_parquet
-    from sgdata.usd.geometry import read_geometry
-    from sgdata.usd.room_io import read_room
+    from sgdata.dataset.rows import write_parquet
+    from sgdata.pipeline.view_encoder import ViewEncoder
+    from sgdata.usd.layout_meshes import LayoutMeshes
+    from sgdata.usd.room_io import read_scene
 
     with clock.stage("renderer start"):
         annotator, class_ids = _annotator(config)
@@ -180,44 +187,48 @@ def _render_room_views(
     by_layout: dict[int, list[PoseKey]] = defaultdict(list)
     for key in poses:
         by_layout[key.layout].append(key)
-    records, scene_paths = [], []
+    scene_paths = []
+    meshes = LayoutMeshes()  # what the room's layouts share is read once
     try:
-        for layout in sorted(by_layout):
-            path = layout_file(room_dir, layout)
-            with clock.stage("USD load"):
-                room = read_room(path)
-                geometry = read_geometry(path)
-            with clock.stage("scene build"):
-                annotator.set_layout(room, geometry, layout)
-            with clock.stage("pose grid"):
-                grid = config.poses.grid(room)
-            for key in sorted(by_layout[layout]):
-                seed = view_seed(room_seed, key.layout, key.i, key.j, key.heading)
-                noise = rng_for(seed) if config.poses.noise else None
-                x, y, theta = grid.pose_world(key.i, key.j, key.heading, rng=noise)
-                with clock.stage("view record"):
-                    pose = ViewPose(x, y, theta, key.i, key.j, key.heading)
-                    records.append(annotator.view(pose, seed=seed))
-                scene_paths.append(path.relative_to(root).as_posix())
+        with ViewEncoder(config.images.format, jpeg_quality=config.images.jpeg_quality) as encoder:
+            for layout in sorted(by_layout):
+                path = layout_file(room_dir, layout)
+                with clock.stage("USD load"):
+                    room, geometry = read_scene(path, meshes)
+                with clock.stage("scene build"):
+                    annotator.set_layout(room, geometry, layout)
+                with clock.stage("pose grid"):
+                    grid = config.poses.grid(room)
+                for key in sorted(by_layout[layout]):
+                    seed = view_seed(room_seed, key.layout, key.i, key.j, key.heading)
+                    noise = rng_for(seed) if config.poses.noise else None
+                    x, y, theta = grid.pose_world(key.i, key.j, key.heading, rng=noise)
+                    with clock.stage("view record"):
+                        pose = ViewPose(x, y, theta, key.i, key.j, key.heading)
+                        encoder.add(annotator.view(pose, seed=seed))
+                    scene_paths.append(path.relative_to(root).as_posix())
+            # what is left: the encodes still running, then the rows
+            with clock.stage("rows + image encode"):
+                table = encoder.table(
+                    room_type=task.room_type,
+                    split=task.split,
+                    scene_paths=scene_paths,
+                    class_ids=class_ids,
+                )
     finally:
         annotator.clock = NO_CLOCK  # the worker's annotator outlives this task
-    with clock.stage("rows + image encode"):
-        table = observation_table(
-            records,
-            room_type=task.room_type,
-            split=task.split,
-            scene_paths=scene_paths,
-            image_format=config.images.format,
-            jpeg_quality=config.images.jpeg_quality,
-            class_ids=class_ids,
-        )
     relative = observations_path(task.split, task.room_id)
     with clock.stage("Parquet write"):
         rows, sha256, size = _guarded(lambda: write_parquet(table, root / relative))
     record = {"path": relative, "rows": rows, "sha256": sha256, "bytes": size}
     with clock.stage("ledger"):
         write_record(views_record(root, task.room_id), record)
-    return len(records)
+    return len(encoder)
+
+
+def peak_rss_mib() -> float:
+    """This process's peak resident memory so far, in MiB (Linux reports KiB)."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
 
 def _stages(clock: Clock) -> dict:

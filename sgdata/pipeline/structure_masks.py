@@ -17,8 +17,7 @@ import pyarrow as pa
 from sgdata.dataset.channels import encode_mask
 from sgdata.render.camera import CameraConfig
 from sgdata.render.renderer import Renderer
-from sgdata.usd.geometry import read_geometry
-from sgdata.usd.room_io import door_quad, read_room
+from sgdata.usd.room_io import door_quad, read_scene
 
 __all__ = ["structure_column"]
 
@@ -40,9 +39,8 @@ def structure_column(root: Path, table: pa.Table, config: dict[str, Any]) -> pa.
                 continue
             if row["scene"] != loaded:
                 stage = root / row["scene"]
-                geometry = dataclasses.replace(
-                    read_geometry(stage), door=door_quad(read_room(stage))
-                )
+                room, geometry = read_scene(stage)
+                geometry = dataclasses.replace(geometry, door=door_quad(room))
                 renderer.load(geometry)
                 loaded = row["scene"]
             parts = renderer.render_structure(row["x"], row["y"], row["theta"])

@@ -22,6 +22,7 @@ from pxr import Tf, Usd, UsdGeom
 from sgdata.errors import UsdError
 from sgdata.usd.bound_materials import MaterialReader
 from sgdata.usd.gprims import tessellate_gprim
+from sgdata.usd.layout_meshes import LayoutMeshes, LayoutScope
 from sgdata.usd.meshes import Lighting, MeshData, ObjectGeometry, SceneGeometry, merge_meshes
 from sgdata.usd.object_prims import drawn_prims, instance_ids, is_object
 from sgdata.usd.prims import LIGHT_INTENSITY, LIGHT_TEMPERATURE
@@ -35,7 +36,7 @@ __all__ = ["DEFAULT_COLOR", "prim_triangles", "read_geometry", "stage_geometry"]
 DEFAULT_COLOR = (0.6, 0.6, 0.6)  # face colour of meshes without a displayColor
 
 
-def read_geometry(path: Path) -> SceneGeometry:
+def read_geometry(path: Path, meshes: LayoutMeshes | None = None) -> SceneGeometry:
     """The triangle meshes of the composed stage at ``path`` (a room, a layout, any USD file).
 
     Invisible prims and guide/proxy purposes are skipped; instance proxies are followed. Meshes
@@ -44,6 +45,9 @@ def read_geometry(path: Path) -> SceneGeometry:
     metres, see :func:`sgdata.usd.stage_frame.stage_frame`) whatever the stage's up axis,
     units and origin.
 
+    With ``meshes`` (:class:`~sgdata.usd.layout_meshes.LayoutMeshes`, one per room) the prims a
+    layout layer leaves alone are taken from the room's earlier layouts instead of re-read.
+
     Raises:
         UsdError: the file is missing, unreadable or does not compose, an object prim has
             a non-integer or duplicate ``sgdata:instance``, a mesh is malformed (NaN or inf
@@ -51,13 +55,15 @@ def read_geometry(path: Path) -> SceneGeometry:
             is not finite or (for an object) singular.
     """
     path = Path(path)
-    return stage_geometry(open_stage(path), path)
+    return stage_geometry(open_stage(path), path, meshes)
 
 
-def stage_geometry(stage: Usd.Stage, path: Path) -> SceneGeometry:
+def stage_geometry(
+    stage: Usd.Stage, path: Path, meshes: LayoutMeshes | None = None
+) -> SceneGeometry:
     """:func:`read_geometry` of an open stage (``path`` names it in messages)."""
     with np.errstate(over="ignore", invalid="ignore"):  # overflow is refused just below
-        geometry = _read_stage(stage, path)
+        geometry = _read_stage(stage, path, None if meshes is None else meshes.scope(stage))
         parts = [(m.name, m.vertices) for m in geometry.structure]
         parts += [(o.mesh.name, o.world_vertices()) for o in geometry.objects]
     for name, vertices in parts:
@@ -69,7 +75,7 @@ def stage_geometry(stage: Usd.Stage, path: Path) -> SceneGeometry:
     return geometry
 
 
-def _read_stage(stage: Usd.Stage, path: Path) -> SceneGeometry:
+def _read_stage(stage: Usd.Stage, path: Path, scope: LayoutScope | None) -> SceneGeometry:
     frame = stage_frame(stage)
     cache = UsdGeom.XformCache(Usd.TimeCode.Default())
     owners: dict[str, Usd.Prim] = {}  # object prim path -> prim, in traversal order
@@ -80,11 +86,15 @@ def _read_stage(stage: Usd.Stage, path: Path) -> SceneGeometry:
         if is_object(prim):
             owners[str(prim.GetPath())] = prim
             parts.setdefault(str(prim.GetPath()), [])
-        try:
-            _check_value_types(prim)
-            found = _prim_triangles(prim, materials)
-        except UsdError as exc:
-            raise UsdError(f"{path}: {exc}") from None
+        kept, found = (False, None) if scope is None else scope.get(prim.GetPath())
+        if not kept:
+            try:
+                _check_value_types(prim)
+                found = _prim_triangles(prim, materials)
+            except UsdError as exc:
+                raise UsdError(f"{path}: {exc}") from None
+            if scope is not None:
+                scope.keep(prim.GetPath(), found)
         if found is None:
             continue
         try:

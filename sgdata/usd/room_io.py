@@ -36,12 +36,14 @@ import numpy as np
 from pxr import Gf, Kind, Sdf, Usd, UsdGeom, Vt
 
 from sgdata.errors import SceneError, UsdError
-from sgdata.usd.meshes import MeshData
+from sgdata.usd.geometry import stage_geometry
+from sgdata.usd.meshes import MeshData, SceneGeometry
 from sgdata.usd.prims import OBJECTS, ROOT, STRUCTURE, object_path
 from sgdata.usd.stage import open_stage, write_usd_file
 from sgdata.world.scene import WALLS, Dynamics, Opening, Placement, Room, SceneObject
 
 if TYPE_CHECKING:
+    from sgdata.usd.layout_meshes import LayoutMeshes
     from sgdata.usd.looks import RoomDresser
     from sgdata.world.appearance import AppearanceConfig
     from sgdata.world.catalog import Catalog
@@ -410,7 +412,23 @@ def read_room(path: Path) -> Room:
             attribute this module writes (the message names the prim and the attribute).
     """
     path = Path(path)
+    return _stage_room(open_stage(path), path)
+
+
+def read_scene(path: Path, meshes: LayoutMeshes | None = None) -> tuple[Room, SceneGeometry]:
+    """The room of :func:`read_room` and the meshes of :func:`sgdata.usd.geometry.
+    read_geometry` from one opening of the stage at ``path`` (``meshes``: the room's meshes
+    kept across its layouts, see :mod:`sgdata.usd.layout_meshes`).
+
+    Raises:
+        UsdError: as either function.
+    """
+    path = Path(path)
     stage = open_stage(path)
+    return _stage_room(stage, path), stage_geometry(stage, path, meshes)
+
+
+def _stage_room(stage: Usd.Stage, path: Path) -> Room:
     from sgdata.usd.user_rooms import is_measured, measure_stage  # late: it reads geometry
 
     if is_measured(stage):  # a room authored elsewhere, tagged or not

@@ -23,18 +23,24 @@ def test_the_page_is_the_scripts_figures(tmp_path: Path, mini_dataset: Path) -> 
         stamp
     )
     assert json.loads((out / "validate.json").read_text()) == validate
-    # a generate record as bench/generate.py prints it, two rounds of 1 worker, 2 workers and
-    # Ray interleaved: the page takes each one's fastest round and computes the ratios
-    runs = [
-        {"views": 70, "wall_s": 7.0, "views_per_s": 10.0},
-        {"views": 70, "wall_s": 3.5, "views_per_s": 20.0},
-        {"views": 70, "wall_s": 4.0, "views_per_s": 17.5},
-        {"views": 70, "wall_s": 8.75, "views_per_s": 8.0},
-        {"views": 70, "wall_s": 4.375, "views_per_s": 16.0},
-        {"views": 70, "wall_s": 3.5, "views_per_s": 20.0},
-    ]
+
+    # a generate record: bench/render.py's figures, then bench/generate.py's two rounds of 1
+    # worker, 2 workers and Ray interleaved: the page takes each one's fastest round and
+    # computes the ratios, 1 worker's against the textured pipeline's
+    def run(wall: float, rate: float, peaks: tuple[float, float] = (400.0, 401.0)) -> dict:
+        return {
+            "views": 70,
+            "wall_s": wall,
+            "views_per_s": rate,
+            "worker_peak_after_3_mib": peaks[0],
+            "worker_peak_after_all_mib": peaks[1],
+        }
+
+    runs = [run(7.0, 10.0), run(3.5, 20.0), run(4.0, 17.5), run(8.75, 8.0, (398.0, 420.4)),
+            run(4.375, 16.0), run(3.5, 20.0)]  # fmt: skip
+    generated = {"render": {"pipeline_textured": 12.5}, "runs": runs}
     settled = {**stamp, "settled_s": 54.0}  # it waited for the load to fall before it ran
-    record = {"measure": "generate", "stamp": settled, "commands": [["x"]], "result": runs}
+    record = {"measure": "generate", "stamp": settled, "commands": [["x"]], "result": generated}
     (out / "generate.json").write_text(json.dumps(record))
 
     # a profile record as bench/generate.py --profile prints it, 1 worker then 2
@@ -74,10 +80,12 @@ def test_the_page_is_the_scripts_figures(tmp_path: Path, mini_dataset: Path) -> 
     result = channels["result"]
     assert f"| channels / RGB only | {result['ratio']:.2f}x | >= 0.85x |" in doc
     assert f"| PNG bytes per view, image | {result['bytes_per_view']['image']:,} |" in doc
-    assert "| local, 1 worker: 70 views in 7.0 s, 8.75 s | 10.00 views/s |  |" in doc
+    assert "| local, 1 worker: 70 views in 7.0 s, 8.75 s | 10.00 views/s | 400 / 420 |  |" in doc
     assert "at the start (after 54 s waiting for it to settle): `x`" in doc
-    assert "| **2 workers / 1** | 2.00x (rounds 2.00x to 2.00x) | >= 1.8x |" in doc
-    assert "| **Ray local / local pool** | 1.00x (rounds 0.88x to 1.25x) | >= 0.8x |" in doc
+    assert "| **2 workers / 1** | 2.00x (rounds 2.00x to 2.00x) |  | >= 1.8x |" in doc
+    assert "| **Ray local / local pool** | 1.00x (rounds 0.88x to 1.25x) |  | >= 0.8x |" in doc
+    alone = "textured: 12.5 annotated views/s) | 0.80x (rounds 0.64x to 0.80x) |  | >= 0.85x |"
+    assert alone in doc
     assert "| `seannet` | 4.250 | 1.70x | 31 % | 0 % | 56 |" in doc
     assert "| views | render | 3.50 s (50.0 %) | 3.00 s (50.0 %) |" in doc
     assert "| views | outside the tasks | 1.75 s (25.0 %) | 2.00 s (25.0 %) |" in doc
