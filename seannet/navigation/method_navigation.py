@@ -34,15 +34,16 @@ NAVIGATION_DIR = "navigation"  # under the card's directory: results, maps, part
 def navigation_test(
     directory: Path,
     *,
-    navigator: Path,
+    navigator: Path | None,
     data: DataSource,
     config: NavigationTestConfig,
     workers: int = 1,
     stop_policy: bool = False,
     val_episodes: int = STOP_POLICY_VAL_EPISODES,
 ) -> dict[str, Any]:
-    """Run the navigation test with the method directory ``directory`` as localizer; the
-    card's summary of it: settings, epsilon and, per rule and case, the outcome rates (%);
+    """Run the navigation test with the method directory ``directory`` as localizer (and the
+    ``navigator`` run, or None for the oracle navigator); the card's summary of it: settings,
+    epsilon and, per rule and case, the outcome rates (%);
     with ``stop_policy``, the rule chosen on ``val_episodes`` per case and room of the val
     rooms and its row beside the paper's.
 
@@ -53,7 +54,7 @@ def navigation_test(
     """
     out = directory / NAVIGATION_DIR
     summary: dict[str, Any] = {
-        "navigator": str(navigator),
+        "navigator": "oracle" if navigator is None else str(navigator),
         "split": config.split,
         "episodes_per_case_and_room": config.episodes,
     }

@@ -18,6 +18,12 @@ The order of choices follows DESIGN §12:
 
 A method that is not a bundled network (a reference method, a plug-in) makes its own choices
 on val inside ``fit``: one unit per seed. A method with no ``fit`` is run on one seed.
+
+The navigation test (:class:`NavigationDesign`, paper Table II) has units of its own, so that
+asking it adds units and re-runs none: per method and seed, its network trained again at the
+lr val chose (the same seed gives the same weights), then the method is the localizer of the
+test, its stop rule chosen on val episodes and the test episodes read once by the paper's rule
+and by the chosen one. One method a unit: two tests on one training would pass the limit.
 """
 
 from __future__ import annotations
@@ -37,7 +43,9 @@ __all__ = [
     "DESIGN",
     "Design",
     "Evaluation",
+    "NAVIGATION",
     "NOISE_GRID",
+    "NavigationDesign",
     "PROTOCOL_VERSION",
     "Plan",
     "Row",
@@ -45,6 +53,7 @@ __all__ = [
     "chosen_lrs",
     "covers",
     "diagnostic_unit",
+    "navigation_unit",
     "network_of",
     "plan_units",
 ]
@@ -82,6 +91,24 @@ class Row:
     stage: int = 0  # run order: every unit of stage 0 before any of stage 1 (the headline first)
 
 
+# a navigation unit's name ends with it: it trains what a headline unit trains, for another test
+NAVIGATION = "nav"
+
+
+@dataclass(frozen=True)
+class NavigationDesign:
+    """The navigation test the docs need: which methods localize, on how many seeds, on how
+    many episodes. ``navigator`` is a ``seannet train-navigator`` run on this machine, or None
+    for the oracle navigator (the right action from the true pose): it needs no model kept
+    between units, and it leaves the stop decision as the only failure the localizer causes."""
+
+    methods: tuple[str, ...]
+    seeds: int = len(DEFAULT_SEEDS)
+    episodes: int = 20  # test episodes per case and room
+    val_episodes: int = 50  # val episodes per case and room the stop rule is chosen on
+    navigator: str | None = None
+
+
 @dataclass(frozen=True)
 class Design:
     """Every row the docs need, and the rules they are measured by."""
@@ -99,11 +126,15 @@ class Design:
     limit_s: float = LIMIT_S
     map_spacing: int = 1  # the full map: every reachable cell
     diagnostics: tuple[str, ...] = ()  # units that train nothing: COVISIBILITY
+    navigation: NavigationDesign | None = None
 
     def __post_init__(self) -> None:
         names = [r.method for r in self.rows]
         if len(set(names)) != len(names):
             raise ModelError(f"protocol: a method is named twice in {names}")
+        rowless = [m for m in self.navigation.methods if m not in names] if self.navigation else []
+        if rowless:
+            raise ModelError(f"protocol: navigation methods {rowless} have no row")
         if not self.lrs or any(lr <= 0 for lr in self.lrs):
             raise ModelError(f"protocol: learning rates must be > 0, got {self.lrs}")
         unknown = [m for m in self.curve_methods if m not in names]
@@ -127,6 +158,7 @@ class Evaluation:
     method: str
     noise: tuple[BoxNoise, ...] = ()
     full_map: bool = False
+    navigation: bool = False  # the navigation test with this method as localizer
 
 
 @dataclass(frozen=True)
@@ -139,6 +171,9 @@ class Unit:
     lr: float | None  # None: the method chooses its own on val
     evaluations: tuple[Evaluation, ...]
     network: bool = True  # trains a bundled network (calibrated batches, an lr)
+    # NAVIGATION: a unit of the navigation test; its name says so, and names its method when
+    # that is not what it trains (seannet-fc512+box-kernel on seannet-fc512)
+    purpose: str = ""
 
     @property
     def name(self) -> str:
@@ -151,6 +186,9 @@ class Unit:
         if self.lr is not None:
             parts.append(f"lr{self.lr:g}")
         parts.append(f"s{self.seed}")
+        if self.purpose:
+            parts.append(self.purpose)
+            parts += [method_label(e.method) for e in self.evaluations if e.method != self.trains]
         return "-".join(parts)
 
     def to_dict(self) -> dict[str, Any]:
@@ -160,8 +198,14 @@ class Unit:
             "budget_s": self.budget_s,
             "lr": self.lr,
             "network": self.network,
+            "purpose": self.purpose,
             "evaluations": [
-                {"method": e.method, "noise": [n.label() for n in e.noise], "full_map": e.full_map}
+                {
+                    "method": e.method,
+                    "noise": [n.label() for n in e.noise],
+                    "full_map": e.full_map,
+                    "navigation": e.navigation,
+                }
                 for e in self.evaluations
             ],
         }
@@ -277,6 +321,9 @@ def plan_units(design: Design, records: dict[str, dict[str, Any]]) -> Plan:
                 for seed in range(seeds):
                     evaluations = tuple(Evaluation(r.method) for r in curve)
                     later.append(Unit(network, seed, budget, lr, evaluations))
+    navigation, waiting = _navigation_units(design, records)
+    later += navigation
+    plan.pending += waiting
     # by stage (the headline before the fc and the ablations), the curve's other budgets last;
     # within a stage every row's first seed before any row's second (a partial doc has each
     # row early), then the rows' order; a diagnostic runs with the first seeds
@@ -295,6 +342,35 @@ def plan_units(design: Design, records: dict[str, dict[str, Any]]) -> Plan:
     return plan
 
 
+def navigation_unit(design: Design, method: str, seed: int, lr: float | None) -> Unit:
+    """The navigation unit of ``method``'s seed (``lr``: the one val chose for its network)."""
+    evaluations = (Evaluation(method, navigation=True),)
+    network = network_of(method)
+    if network is None:
+        return Unit(method, seed, None, None, evaluations, network=False, purpose=NAVIGATION)
+    return Unit(network, seed, design.budget_s, lr, evaluations, purpose=NAVIGATION)
+
+
+def _navigation_units(design: Design, records: dict[str, dict[str, Any]]) -> tuple[list[Unit], int]:
+    """The navigation test's units that can be planned now, and how many wait on an lr."""
+    nav = design.navigation
+    if nav is None:
+        return [], 0
+    units: list[Unit] = []
+    pending = 0
+    for method in nav.methods:
+        # a method that fits nothing gives every seed the same test: its row's seeds bound it
+        seeds = min(nav.seeds, design.row(method).seeds)
+        network = network_of(method)
+        chosen = None if network is None else chosen_lrs(design, network, records)
+        if network is not None and chosen is None:
+            pending += seeds
+            continue
+        lr = None if chosen is None else chosen[method]
+        units += [navigation_unit(design, method, seed, lr) for seed in range(seeds)]
+    return units, pending
+
+
 def covers(record: dict[str, Any], unit: Unit) -> bool:
     """Whether ``record`` holds every evaluation ``unit`` asks (a record made for a design
     that asked less is run again, and its new record replaces it)."""
@@ -304,6 +380,8 @@ def covers(record: dict[str, Any], unit: Unit) -> bool:
         if got is None or e.method not in record["results"]:
             return False
         if not {n.label() for n in e.noise} <= set(got["noise"]) or e.full_map > got["full_map"]:
+            return False
+        if e.navigation > got.get("navigation", False):
             return False
     return True
 
@@ -338,9 +416,16 @@ ABLATIONS = (
 )
 CURVE_METHODS = (SEANNET, "resnet18+boxes", f"{SEANNET}+box-kernel")
 
+# Table II: SeanNet, its box-kernel fusion (the best localizer of docs/navigation.md), the
+# strongest simple baseline, and the image-only floor, as localizers of the oracle navigator
+NAVIGATION_TEST = NavigationDesign(
+    methods=(SEANNET, f"{SEANNET}+box-kernel", "resnet18+boxes", "tiny-image")
+)
+
 DESIGN = Design(
     rows=HEADLINE + FC + ABLATIONS,
     curve_methods=CURVE_METHODS,
     curve=((150.0, 3), (600.0, 3), (1200.0, 1)),
     diagnostics=(COVISIBILITY,),
+    navigation=NAVIGATION_TEST,
 )

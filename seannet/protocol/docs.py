@@ -183,6 +183,58 @@ def _full_map_table(r: Records) -> tuple[list[str], dict[str, float]]:
     return table(header, rows), recall
 
 
+NAVIGATION_AIM = {"N": 80.0, "A": 65.0}  # success % the chosen stop rule aims at (paper Table II)
+
+
+def _navigation_section(r: Records) -> list[str]:
+    """Success per rule and case, each method's seeds: their mean and an interval holding
+    every seed's (the lowest and highest of the seeds' 95 % intervals clustered by room);
+    the chosen rules, and the aim against the best chosen row."""
+    nav = r.design.navigation
+    if nav is None:
+        return []
+    navigator = "the oracle navigator" if nav.navigator is None else f"navigator `{nav.navigator}`"
+    rows, rules, best = [], [], {}
+    for method in nav.methods:
+        found = r.navigation(method)
+        seeds = seeds_cell(len(found), min(nav.seeds, r.design.row(method).seeds))
+        if not found:
+            rows.append([f"`{method}`", seeds, "", "", "", ""])
+            continue
+        cells = []
+        for rule in ("paper", "chosen"):
+            for case in ("N", "A"):
+                got = [f["rates"][rule][case]["success"] for f in found]
+                mean = float(np.mean([g["percent"] for g in got]))
+                cells.append(f"{mean:.1f} [{min(g['low'] for g in got):.0f}, "
+                             f"{max(g['high'] for g in got):.0f}]")  # fmt: skip
+                if rule == "chosen":
+                    best[case] = max(best.get(case, 0.0), mean)
+        rows.append([f"`{method}`", seeds, *cells])
+        rules.append(f"- `{method}`: " + "; ".join(f["stop_rule"]["label"] for f in found))
+    aim = " and ".join(
+        f"{case} {best.get(case, 0.0):.1f} % against {goal:.0f} % "
+        f"({'met' if best.get(case, 0.0) >= goal else 'missed'})"
+        for case, goal in NAVIGATION_AIM.items()
+    )
+    header = ["localizer", "seeds", "paper rule N %", "paper rule A %", "chosen rule N %",
+              "chosen rule A %"]  # fmt: skip
+    return [
+        f"Each localizer's navigation test, with {navigator}, {nav.episodes} test episodes per "
+        "case and test room: the paper's rule (epsilon chosen on val triplets, the first "
+        f"failure ends the episode) and the stop rule chosen on {nav.val_episodes} val "
+        "episodes per case and val room for navigation success. Cells: the seeds' mean "
+        "success and an interval holding every seed's 95 % interval clustered by room.",
+        "",
+        *table(header, rows),
+        "",
+        *([f"Aim (success with the chosen rule, best localizer): {aim}.", ""] if best else []),
+        "The rule each seed chose:",
+        "",
+        *(rules or ["- none recorded yet"]),
+    ]
+
+
 def _budget_table(r: Records) -> list[str]:
     """What each network's budget bought, and the calibration it rests on."""
     rows = []
@@ -410,6 +462,8 @@ def results_doc(r: Records) -> str:
         "",
         *full_map,
     ]
+    if design.navigation is not None:
+        out += ["", "## Navigation (paper Table II)", "", *_navigation_section(r)]
     fc = [row.method for row in FC if row.method in {x.method for x in design.rows}]
     if fc:
         out += [
@@ -450,7 +504,11 @@ def results_doc(r: Records) -> str:
         *(["![accuracy against budget](learning-curve.png)", ""] if curve_points(r) else []),
         "## Not measured by this protocol",
         "",
-        "- Navigation with each network as localizer (docs/navigation.md has its own runs).",
+        *(
+            ["- Navigation with each network as localizer (docs/navigation.md has its own runs)."]
+            if design.navigation is None
+            else []
+        ),
         f"- The `paper` preset on a GPU (ResNet-{PAPER.depth} at {PAPER.image_size} px).",
         "",
     ]

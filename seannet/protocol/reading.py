@@ -19,6 +19,7 @@ from seannet.protocol.design import (
     Plan,
     Unit,
     chosen_lrs,
+    navigation_unit,
     network_of,
     plan_units,
 )
@@ -79,6 +80,18 @@ class Records:
     def runs(self, method: str, budget: float | None = None) -> list[dict[str, Any]]:
         """``method``'s per-seed results (the benchmark harness's) at its chosen lr."""
         return [r["results"][method] for r in self.unit_records(method, budget)]
+
+    def navigation(self, method: str) -> list[dict[str, Any]]:
+        """``method``'s navigation tests, seed order, those recorded only (at its chosen lr)."""
+        nav = self.design.navigation
+        if nav is None or method not in nav.methods:
+            return []
+        lr = self.lr(method)
+        if network_of(method) is not None and lr is None:
+            return []
+        names = [navigation_unit(self.design, method, s, lr).name for s in range(nav.seeds)]
+        results = [self.found.units.get(n, {}).get("results", {}).get(method, {}) for n in names]
+        return [r["navigation"] for r in results if "navigation" in r]
 
 
 # ------------------------------------------------------------------------------ cells

@@ -28,6 +28,8 @@ TRAIN_PER_BUDGET_S = 1.0  # wall seconds per budget second (the budget is one th
 PASS_S = 120.0  # one evaluation pass: val and test embedded, or test under one noise level
 FULL_MAP_S = 900.0  # rendering and embedding every sub-node of the test rooms
 METHOD_S = 300.0  # a method that is not a bundled network, fit and evaluation
+# the navigation test of one localizer, oracle navigator: val and test episodes rendered live
+NAVIGATION_S = 900.0
 
 
 @dataclass(frozen=True)
@@ -65,10 +67,14 @@ def estimate(unit: Unit, found: Found) -> Estimate:
     same = [r for r in found.units.values() if r["trains"] == unit.trains]
     passes = sum(1 + len(e.noise) for e in unit.evaluations)
     maps = sum(e.full_map for e in unit.evaluations)
+    tests = sum(e.navigation for e in unit.evaluations)
+    navigation_s = max((_extra_s(r, "navigation") for r in found.units.values()
+                        if _extra_s(r, "navigation")), default=NAVIGATION_S)  # fmt: skip
     if not unit.network:
         if same:
-            return Estimate(max(r["seconds"]["wall"] for r in same), "records")
-        return Estimate(METHOD_S + FULL_MAP_S * maps, "prior")
+            base = max(r["seconds"]["wall"] - _extra_s(r, "navigation") for r in same)
+            return Estimate(base + tests * navigation_s, "records")
+        return Estimate(METHOD_S + FULL_MAP_S * maps + tests * navigation_s, "prior")
     assert unit.budget_s is not None
     train_rate, pass_s, map_s, source = TRAIN_PER_BUDGET_S, PASS_S, FULL_MAP_S, "prior"
     if same:
@@ -78,19 +84,27 @@ def estimate(unit: Unit, found: Found) -> Estimate:
         maps_seen = [m["full_map"]["seconds"] for r in same for m in r["results"].values()
                      if "full_map" in m]  # fmt: skip
         map_s = max(maps_seen, default=FULL_MAP_S)
-    return Estimate(unit.budget_s * train_rate + passes * pass_s + maps * map_s, source)
+    return Estimate(
+        unit.budget_s * train_rate + passes * pass_s + maps * map_s + tests * navigation_s, source
+    )
 
 
 def _fit_s(record: dict[str, Any]) -> float:
     return max(m["cost"]["fit_s"] for m in record["results"].values())
 
 
+def _extra_s(record: dict[str, Any], part: str) -> float:
+    """A record's seconds in ``part`` (``full_map``, ``navigation``) of its evaluations."""
+    return sum(m[part]["seconds"] for m in record["results"].values() if part in m)
+
+
 def _pass_s(record: dict[str, Any]) -> float:
-    """A record's evaluation seconds per pass (its wall less its training and maps)."""
+    """A record's evaluation seconds per pass (its wall less its training, maps and
+    navigation tests)."""
     rest = record["seconds"]["wall"] - _fit_s(record)
-    maps = sum(m["full_map"]["seconds"] for m in record["results"].values() if "full_map" in m)
+    extras = _extra_s(record, "full_map") + _extra_s(record, "navigation")
     passes = sum(1 + len(e["noise"]) for e in record["evaluations"])
-    return max(rest - maps, 0.0) / passes
+    return max(rest - extras, 0.0) / passes
 
 
 def _minutes(seconds: float) -> str:
@@ -133,6 +147,8 @@ def _evaluation_text(e: Any) -> str:
         extras.append(f"{len(e.noise)} noise")
     if e.full_map:
         extras.append("full map")
+    if e.navigation:
+        extras.append("navigation")
     return e.method + (f" ({', '.join(extras)})" if extras else "")
 
 

@@ -108,6 +108,9 @@ def run_unit(
         if evaluation.full_map:
             say(f"{evaluation.method}: full map of the test rooms, seed {unit.seed}")
             result["full_map"] = _full_map(evaluation.method, method, result, ds, work, design)
+        if evaluation.navigation:
+            say(f"{evaluation.method}: the navigation test, seed {unit.seed}")
+            result["navigation"] = _navigation(evaluation.method, method, result, ds, work, design)
         results[evaluation.method] = result
         seconds[evaluation.method] = round(time.perf_counter() - clock, 1)
         training = training or _training(method, batches)
@@ -217,6 +220,35 @@ def _full_map(
         },  # fmt: skip
         "seconds": round(time.perf_counter() - clock, 1),
     }
+
+
+def _navigation(
+    name: str, method: Any, result: dict[str, Any], ds: Dataset, work: Path, design: Design
+) -> dict[str, Any]:
+    """The navigation test with the method as localizer (the benchmark card's: its epsilon
+    chosen on val by the harness, its stop rule chosen on val episodes, the test episodes
+    read once by the paper's rule and by the chosen one), and its seconds."""
+    from seannet.methods.localizer import save_method
+    from seannet.navigation.config import NavigationTestConfig
+    from seannet.navigation.method_navigation import navigation_test
+
+    nav = design.navigation
+    assert nav is not None
+    clock = time.perf_counter()
+    directory = work / "navigation" / method_label(name)
+    directory.mkdir(parents=True, exist_ok=True)
+    save_method(directory, name, method, epsilon=result["threshold"]["epsilon"],
+                epsilon_source="val (protocol unit)", data=ds)  # fmt: skip
+    got = navigation_test(
+        directory,
+        navigator=None if nav.navigator is None else Path(nav.navigator),
+        data=ds,
+        config=NavigationTestConfig(episodes=nav.episodes),
+        stop_policy=True,
+        val_episodes=nav.val_episodes,
+    )
+    got.pop("results")  # a path of this machine's work folder, gone with the unit
+    return {**got, "seconds": round(time.perf_counter() - clock, 1)}
 
 
 def _diagnostic(

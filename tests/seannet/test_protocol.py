@@ -18,13 +18,18 @@ from pathlib import Path
 import pytest
 
 from seannet.data.box_noise import BoxNoise
+from seannet.errors import ModelError
 from seannet.evaluation.covisibility_oracle import step_direction
+from seannet.navigation.episodes import OUTCOMES
 from seannet.protocol.design import (
     AIM,
     COVISIBILITY,
     DESIGN,
+    NAVIGATION,
     Design,
+    NavigationDesign,
     Row,
+    covers,
     diagnostic_unit,
     plan_units,
 )
@@ -293,3 +298,73 @@ def test_the_committed_docs_are_what_the_committed_records_say(tmp_path: Path) -
         assert (tmp_path / name).read_text() == (root / "docs" / name).read_text(), (
             f"docs/{name} is not what the records say: run `seannet results doc`"
         )
+
+
+def test_navigation_units_add_to_the_plan_and_re_run_nothing() -> None:
+    rows = (Row("seannet-fc512", seeds=3), Row("seannet-fc512+box-kernel", seeds=3),
+            Row("tiny-image", seeds=1))  # fmt: skip
+    plain = Design(rows=rows)
+    nav = NavigationDesign(methods=("seannet-fc512", "seannet-fc512+box-kernel", "tiny-image"))
+    design = Design(rows=rows, navigation=nav)
+    # before seed 0 chooses the lr: tiny-image's one unit (it fits nothing: one seed), and
+    # each spec's three wait on the choice
+    first = plan_units(design, {})
+    assert [u.name for u in first.todo if u.purpose] == ["tiny-image-s0-nav"]
+    assert first.pending == plan_units(plain, {}).pending + 6
+    val = {"seannet-fc512": 0.8, "seannet-fc512+box-kernel": 0.85}
+    records = {f"seannet-fc512-b300-lr{lr:g}-s0": _val_record(val) for lr in design.lrs}
+    then = plan_units(design, records)
+    navigation = [u for u in then.todo if u.purpose == NAVIGATION]
+    # both specs chose 0.003 (ties: the smaller lr); a unit tests one method on its network
+    assert [u.name for u in navigation] == [
+        "seannet-fc512-b300-lr0.003-s0-nav",
+        "seannet-fc512-b300-lr0.003-s0-nav-seannet-fc512+box-kernel", "tiny-image-s0-nav",
+        "seannet-fc512-b300-lr0.003-s1-nav",
+        "seannet-fc512-b300-lr0.003-s1-nav-seannet-fc512+box-kernel",
+        "seannet-fc512-b300-lr0.003-s2-nav",
+        "seannet-fc512-b300-lr0.003-s2-nav-seannet-fc512+box-kernel",
+    ]  # fmt: skip
+    assert [[e.method for e in u.evaluations] for u in navigation[:2]] == [
+        [m] for m in nav.methods[:2]
+    ]
+    assert all(e.navigation for u in navigation for e in u.evaluations)
+    # the headline's units are the plain design's: asking the test re-runs none of them
+    others = [u.name for u in then.todo + then.done if not u.purpose]
+    assert others == [u.name for u in plan_units(plain, records).todo + then.done]
+    # a navigation record without the test (an older one) is run again
+    nav_record = _val_record({"tiny-image": 0.6})
+    assert not covers(nav_record, navigation[2])
+    nav_record["evaluations"][0]["navigation"] = True
+    assert covers(nav_record, navigation[2])
+    with pytest.raises(ModelError, match=r"navigation methods \['resnet18'\] have no row"):
+        Design(rows=rows, navigation=NavigationDesign(methods=("resnet18",)))
+
+
+def test_a_navigation_unit_records_both_rules_and_the_doc_shows_them(
+    mini_dataset: Path, tmp_path: Path
+) -> None:
+    nav = NavigationDesign(methods=("tiny-image",), seeds=1, episodes=1, val_episodes=1)
+    design = Design(rows=(Row("tiny-image", seeds=1),), navigation=nav)
+    records = tmp_path / "records"
+    written = run_for(design, mini_dataset, records, tmp_path / "work")
+    assert [p.stem for p in written] == ["tiny-image-s0", "tiny-image-s0-nav"]
+    record = json.loads(written[1].read_text())
+    got = record["results"]["tiny-image"]["navigation"]
+    assert got["navigator"] == "oracle" and got["stop_rule"]["val_episodes"] == 1
+    for rule in ("paper", "chosen"):
+        for case in ("N", "A"):
+            rates = got["rates"][rule][case]
+            assert rates["episodes"] >= 1
+            assert math.isclose(sum(rates[o]["percent"] for o in OUTCOMES), 100.0)
+            assert (
+                rates["success"]["low"] <= rates["success"]["percent"] <= rates["success"]["high"]
+            )
+    assert not (tmp_path / "work").exists() or not any((tmp_path / "work").rglob("*.pt"))
+    docs = tmp_path / "docs"
+    write_docs(Records(design, find_folder(records, None)), docs)
+    section = (docs / "results.md").read_text().split("## Navigation (paper Table II)")[1]
+    success = got["rates"]["chosen"]["A"]["success"]
+    cell = f"{success['percent']:.1f} [{success['low']:.0f}, {success['high']:.0f}]"
+    assert "| `tiny-image` | 1 | " in section and cell in section.split("\n## ")[0]
+    assert got["stop_rule"]["label"] in section
+    assert "Navigation with each network as localizer" not in (docs / "results.md").read_text()
