@@ -99,6 +99,7 @@ def _write_room_scenes(task: RoomTask, config: GenerateConfig, root: Path, clock
     from sgdata.pipeline.user_rooms import copy_user_room
     from sgdata.usd.room_io import catalog_geometry, read_room, write_room
     from sgdata.usd.scene_dirs import write_layouts
+    from sgdata.usd.stage import open_layer
     from sgdata.world.rooms import generate_room
 
     with clock.stage("catalog"):
@@ -120,6 +121,9 @@ def _write_room_scenes(task: RoomTask, config: GenerateConfig, root: Path, clock
                     appearance=config.appearance,
                 )
             )
+    # held until the layouts are read back: USD drops a layer no stage holds, and every
+    # read of a layout would parse the room's again
+    _room_layer = open_layer(room_file(room_dir))
     with clock.stage("layouts"):
         layouts = _guarded(
             lambda: write_layouts(

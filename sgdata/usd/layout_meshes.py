@@ -33,6 +33,9 @@ class LayoutMeshes:
     layouts of one room. A stage over other layers than the last one starts it afresh."""
 
     def __init__(self) -> None:
+        # the room's layers, held: USD drops a layer no stage holds, and the next layout's
+        # stage would parse the room again
+        self._layers: list[Sdf.Layer] = []
         self._base: tuple[str, ...] = ()
         self._reads: dict[str, MeshData | None] = {}
         self.read = 0  # prims read from their stage
@@ -48,6 +51,7 @@ class LayoutMeshes:
             return None
         if base != self._base:
             self._base, self._reads = base, {}
+        self._layers = list(layers[1:])
         touched = _touched(layers[0], layers[1:], stage)
         return None if touched is None else LayoutScope(self, *touched)
 
