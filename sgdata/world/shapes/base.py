@@ -126,9 +126,17 @@ def build_shape(shape: str, size: Size, variant: int, color: Color) -> ShapeBuil
     return RECIPES[shape](size, variant, color)
 
 
+# trimesh's unit box (its vertices and faces, in its order). ``trimesh.creation.box`` also
+# hands the mesh its face normals, which the constructor checks against the faces: that check
+# was a third of writing a room's USD, and no part's normals are ever read.
+_UNIT_BOX = trimesh.creation.box()
+
+
 def box(extents: Size, center: tuple[float, float, float], color: Color) -> Part:
-    """An axis-aligned box part with the given full extents, centred at ``center``."""
-    mesh = trimesh.creation.box(extents=extents)
+    """An axis-aligned box part with the given full extents, centred at ``center`` (the
+    vertices ``trimesh.creation.box(extents=extents)`` moved to ``center`` gives, exactly)."""
+    vertices = _UNIT_BOX.vertices * np.asarray(extents, dtype=np.float64)
+    mesh = trimesh.Trimesh(vertices=vertices, faces=_UNIT_BOX.faces.copy(), process=False)
     mesh.apply_translation(center)
     return Part(mesh, color)
 
