@@ -52,8 +52,10 @@ class GenerateProgress:
     total: int
     views: int  # views rendered so far in this run
     elapsed: float  # seconds since the phase started
-    # peak resident memory of the worker that ran the room just finished, so far (MiB)
+    # the worker that ran the room just finished: its peak resident memory so far (MiB), and
+    # its threads when it finished (native ones included)
     worker_peak_mib: float = 0.0
+    worker_threads: int = 0
 
 
 def plan_rooms(config: GenerateConfig) -> list[RoomTask]:
@@ -312,8 +314,9 @@ def _run_phase(
             booked += sum(seconds for seconds, _ in stages.values())
         if progress is not None:
             peak = float(result.get("peak_rss_mib", 0.0))
+            threads = int(result.get("threads", 0))
             elapsed = time.perf_counter() - start
-            progress(GenerateProgress(phase, done, total, views, elapsed, peak))
+            progress(GenerateProgress(phase, done, total, views, elapsed, peak, threads))
     if clock is not None and jobs:  # the workers' time no task claimed
         busy = min(engine["workers"], len(jobs)) * (time.perf_counter() - start)
         clock.book(phase, OUTSIDE, max(0.0, busy - booked))

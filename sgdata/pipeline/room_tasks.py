@@ -7,7 +7,9 @@ completion in the ledger last, so a task killed half-way leaves nothing that cou
 from __future__ import annotations
 
 import json
+import re
 import resource
+import threading
 from collections import defaultdict
 from dataclasses import dataclass
 from pathlib import Path
@@ -31,6 +33,7 @@ __all__ = [
     "peak_rss_mib",
     "render_room_views",
     "stage_order",
+    "worker_threads",
     "write_room_scenes",
 ]
 
@@ -83,8 +86,8 @@ def write_room_scenes(
 ) -> dict:
     """Phase 1 of a room: USD room and layouts, and the reachable cells of every layout.
 
-    The result holds the views rendered (none here) and the worker's peak memory so far
-    (``peak_rss_mib``).
+    The result holds the views rendered (none here), the worker's peak memory so far
+    (``peak_rss_mib``) and its threads now (``threads``).
 
     With a ``clock`` (:class:`sgdata.stage_clock.StageClock`) its steps are timed as
     :func:`stage_order` and the result carries the clock's totals under ``"stages"``.
@@ -92,7 +95,7 @@ def write_room_scenes(
     clock = clock or NO_CLOCK
     with clock.phase(SCENES), clock.stage(OTHER):
         _write_room_scenes(task, config, root, clock)
-    return {"views": 0, "peak_rss_mib": peak_rss_mib(), **_stages(clock)}
+    return {"views": 0, **_worker_state(), **_stages(clock)}
 
 
 def _write_room_scenes(task: RoomTask, config: GenerateConfig, root: Path, clock: Clock) -> None:
@@ -164,14 +167,15 @@ def render_room_views(
 ) -> dict:
     """Phase 3 of a room: render the referenced views and write the room's shard.
 
-    The result holds the views rendered and the worker's peak memory so far
-    (``peak_rss_mib``). With a ``clock`` its steps are timed as :func:`stage_order` (the
-    annotator's too) and the result carries the clock's totals under ``"stages"``.
+    The result holds the views rendered, the worker's peak memory so far (``peak_rss_mib``)
+    and its threads now (``threads``). With a ``clock`` its steps are timed as
+    :func:`stage_order` (the annotator's too) and the result carries the clock's totals under
+    ``"stages"``.
     """
     clock = clock or NO_CLOCK
     with clock.phase(VIEWS), clock.stage(OTHER):
         views = _render_room_views(task, poses, config, root, clock)
-    return {"views": views, "peak_rss_mib": peak_rss_mib(), **_stages(clock)}
+    return {"views": views, **_worker_state(), **_stages(clock)}
 
 
 def _render_room_views(
@@ -194,7 +198,9 @@ def _render_room_views(
     scene_paths = []
     meshes = LayoutMeshes()  # what the room's layouts share is read once
     try:
-        with ViewEncoder(config.images.format, jpeg_quality=config.images.jpeg_quality) as encoder:
+        with ViewEncoder(
+            config.images.format, jpeg_quality=config.images.jpeg_quality, pool=_encoding_pool()
+        ) as encoder:
             for layout in sorted(by_layout):
                 path = layout_file(room_dir, layout)
                 with clock.stage("USD load"):
@@ -233,6 +239,31 @@ def _render_room_views(
 def peak_rss_mib() -> float:
     """This process's peak resident memory so far, in MiB (Linux reports KiB)."""
     return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+def worker_threads() -> int:
+    """This process's threads, native ones included (the GL driver's, Arrow's, OpenMP's):
+    Linux's count, else Python's own."""
+    try:
+        status = Path("/proc/self/status").read_text()
+    except OSError:
+        return threading.active_count()
+    found = re.search(r"^Threads:\s+(\d+)", status, re.MULTILINE)
+    return int(found.group(1)) if found else threading.active_count()
+
+
+def _worker_state() -> dict:
+    """What a task's result says of the worker that ran it: its peak memory and threads."""
+    return {"peak_rss_mib": peak_rss_mib(), "threads": worker_threads()}
+
+
+def _encoding_pool() -> Any:
+    """This worker's view-encoding thread, started once (it outlives each room task)."""
+    if "encoding" not in _worker:
+        from sgdata.pipeline.view_encoder import encoding_pool
+
+        _worker["encoding"] = encoding_pool()
+    return _worker["encoding"]
 
 
 def _stages(clock: Clock) -> dict:

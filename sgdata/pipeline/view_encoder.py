@@ -5,12 +5,13 @@ encoding thread overlaps the two: a worker with a spare core hides the encode ti
 is encoded by itself, in order, with the same encoder as :func:`sgdata.dataset.rows.
 observation_table`, so the bytes are those of encoding after the room. Only a view's encoded
 bytes are kept once it is encoded, not its pixel arrays, so a room's memory does not grow with
-its images.
+its images. A worker hands every room the same one-thread pool (:func:`encoding_pool`), so its
+threads do not grow with the rooms it renders.
 """
 
 from __future__ import annotations
 
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor, wait
 from dataclasses import replace
 from types import TracebackType
 
@@ -19,19 +20,32 @@ import pyarrow as pa
 from sgdata.annotate.records import ViewRecord
 from sgdata.dataset.rows import EncodedImages, encode_view, observation_table
 
-__all__ = ["ViewEncoder"]
+__all__ = ["ViewEncoder", "encoding_pool"]
+
+
+def encoding_pool() -> ThreadPoolExecutor:
+    """A pool of the one thread views are encoded on (a worker keeps one for all its rooms)."""
+    return ThreadPoolExecutor(max_workers=1, thread_name_prefix="sgdata-encode")
 
 
 class ViewEncoder:
     """Collects a room's views, encoding each on one background thread as it is added.
 
-    Use as a context manager: leaving it stops the thread (dropping the views not yet
-    encoded when an error leaves it early).
+    Use as a context manager: leaving it drops the views not yet encoded (when an error
+    leaves it early) and waits for the one being encoded; it stops the thread too unless the
+    ``pool`` was handed in (:func:`encoding_pool`, kept by its owner).
     """
 
-    def __init__(self, image_format: str = "png", *, jpeg_quality: int = 92) -> None:
+    def __init__(
+        self,
+        image_format: str = "png",
+        *,
+        jpeg_quality: int = 92,
+        pool: ThreadPoolExecutor | None = None,
+    ) -> None:
         self.image_format, self.jpeg_quality = image_format, jpeg_quality
-        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="sgdata-encode")
+        self._owned = pool is None
+        self._pool = encoding_pool() if pool is None else pool
         self._records: list[ViewRecord] = []
         self._encoded: list[Future[EncodedImages]] = []
 
@@ -47,7 +61,11 @@ class ViewEncoder:
         exc: BaseException | None,
         tb: TracebackType | None,
     ) -> None:
-        self._pool.shutdown(wait=True, cancel_futures=True)
+        for future in self._encoded:
+            future.cancel()
+        wait(self._encoded)
+        if self._owned:
+            self._pool.shutdown(wait=True)
 
     def add(self, record: ViewRecord) -> None:
         """Queue ``record``'s images for encoding; keep the record without its pixels."""

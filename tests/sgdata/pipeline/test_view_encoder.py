@@ -12,7 +12,7 @@ import pytest
 
 from sgdata.dataset.rows import observation_table, write_parquet
 from sgdata.errors import DatasetError
-from sgdata.pipeline.view_encoder import ViewEncoder
+from sgdata.pipeline.view_encoder import ViewEncoder, encoding_pool
 
 from ..dataset.test_dataset_format import CLASS_IDS, H, W, room_records
 
@@ -66,3 +66,26 @@ def test_a_view_that_cannot_be_encoded_fails_the_table_and_stops_the_thread() ->
             encoder.add(rec)
         encoder.table(scene_paths=["s"] * len(records), **ROWS)
     assert threading.active_count() == before
+
+
+def test_a_workers_pool_serves_room_after_room_and_outlives_a_failed_one() -> None:
+    records = room_records("kitchen_000")
+    scenes = ["s"] * len(records)
+    pool = encoding_pool()
+    try:
+        with ViewEncoder(pool=pool) as encoder:
+            for rec in records:
+                encoder.add(rec)
+            first = encoder.table(scene_paths=scenes, **ROWS)
+        threads = threading.active_count()
+        bad = dataclasses.replace(records[0], depth=np.zeros((H + 1, W), np.float32))
+        with pytest.raises(DatasetError, match="depth is"), ViewEncoder(pool=pool) as failed:
+            failed.add(bad)
+            failed.table(scene_paths=["s"], **ROWS)
+        with ViewEncoder(pool=pool) as again:  # the next room, on the same thread
+            for rec in records:
+                again.add(rec)
+            assert again.table(scene_paths=scenes, **ROWS).equals(first)
+        assert threading.active_count() == threads
+    finally:
+        pool.shutdown()

@@ -1,8 +1,10 @@
-"""A worker's memory does not grow with the rooms it renders: one worker renders 12 rooms,
-and its peak after the twelfth is within 12 MiB of its peak after the third (each room's
-views, meshes and textures are let go before the next room). Without a leak the peak grows
-~7 MiB over those 9 rooms (the allocator, shape caches), so a leak of 2 MiB a room fails it;
-smaller ones hide in that noise (keeping every layout's meshes adds ~1 MiB a room)."""
+"""A worker's memory and threads do not grow with the rooms it renders. One worker renders
+12 rooms: its threads (native ones included) after each room are those after the first (its
+renderer and its encoding thread are made once), and its peak memory after the twelfth is
+within 12 MiB of its peak after the third (each room's views, meshes and textures are let go
+before the next room). Without a leak the peak grows ~7 MiB over those 9 rooms (the
+allocator, shape caches), so a leak of 2 MiB a room fails it; smaller ones hide in that noise
+(keeping every layout's meshes adds ~1 MiB a room)."""
 
 from __future__ import annotations
 
@@ -35,17 +37,20 @@ texture_size = 128
 """
 
 
-def test_a_workers_peak_memory_is_flat_across_rooms(tmp_path: Path) -> None:
+def test_a_workers_memory_and_threads_are_flat_across_rooms(tmp_path: Path) -> None:
     config = tmp_path / "memory.toml"
     config.write_text(TOML)
     peaks: list[float] = []
+    threads: list[int] = []
 
     def progress(step: GenerateProgress) -> None:
         if step.phase == "views":
             peaks.append(step.worker_peak_mib)
+            threads.append(step.worker_threads)
 
     generate_dataset(load_config(config), tmp_path / "data", workers=1, progress=progress)
     assert len(peaks) == 12
     assert all(peak > 50 for peak in peaks)  # a real process's figure (MiB), not a default
     after_3, after_12 = peaks[2], peaks[-1]
     assert after_12 - after_3 < 12.0, peaks
+    assert threads[0] > 1 and threads == [threads[0]] * 12, threads
