@@ -86,7 +86,7 @@ def _read_stage(stage: Usd.Stage, path: Path, scope: LayoutScope | None) -> Scen
         if is_object(prim):
             owners[str(prim.GetPath())] = prim
             parts.setdefault(str(prim.GetPath()), [])
-        kept, found = (False, None) if scope is None else scope.get(prim.GetPath())
+        kept, found = (False, None) if scope is None else scope.get(prim)
         if not kept:
             try:
                 _check_value_types(prim)
@@ -94,7 +94,7 @@ def _read_stage(stage: Usd.Stage, path: Path, scope: LayoutScope | None) -> Scen
             except UsdError as exc:
                 raise UsdError(f"{path}: {exc}") from None
             if scope is not None:
-                scope.keep(prim.GetPath(), found)
+                scope.keep(prim, found)
         if found is None:
             continue
         try:

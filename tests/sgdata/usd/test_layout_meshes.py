@@ -148,3 +148,82 @@ def test_a_layout_that_re_binds_an_ancestor_or_hides_a_mesh_is_read_afresh(
     shown = {m.name for m in read_geometry(layout_file(room_copy, 1)).structure}
     hidden = {m.name for m in read_geometry(layout_file(room_copy, 0)).structure}
     assert str(mesh) in shown - hidden
+
+
+ROOM_WITH_A_REFERENCE = """#usda 1.0
+(
+    defaultPrim = "Room"
+    metersPerUnit = 1
+    upAxis = "Z"
+)
+
+def Xform "Room"
+{
+    def Mesh "Floor"
+    {
+        int[] faceVertexCounts = [4]
+        int[] faceVertexIndices = [0, 1, 2, 3]
+        point3f[] points = [(0, 0, 0), (4, 0, 0), (4, 4, 0), (0, 4, 0)]
+    }
+
+    def Scope "Protos"
+    {
+        def Xform "Box"
+        {
+            def Mesh "Geom"
+            {
+                int[] faceVertexCounts = [3, 3]
+                int[] faceVertexIndices = [0, 1, 2, 0, 2, 3]
+                point3f[] points = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)]
+                color3f[] primvars:displayColor = [(0.8, 0.2, 0.2)] (
+                    interpolation = "constant"
+                )
+            }
+        }
+    }
+
+    def Xform "Objects"
+    {
+        def Xform "Box_1" (
+            prepend references = </Room/Protos/Box>
+        )
+        {
+            custom string sgdata:class = "Box"
+            custom int sgdata:instance = 1
+            double3 xformOp:translate = (2, 0, 0)
+            uniform token[] xformOpOrder = ["xformOp:translate"]
+        }
+    }
+}
+"""
+
+
+def _layout(path: Path, body: str = "") -> None:
+    path.write_text(f"#usda 1.0\n(\n    subLayers = [@./room.usda@]\n)\n\n{body}")
+
+
+def test_a_layout_that_overrides_what_an_object_references_is_read_afresh(tmp_path: Path) -> None:
+    (tmp_path / "room.usda").write_text(ROOM_WITH_A_REFERENCE)
+    _layout(tmp_path / "layout_0.usda")
+    # the prototype the object references turns green: no spec at the object's own paths
+    _layout(tmp_path / "layout_1.usda", """over "Room"
+{
+    over "Protos"
+    {
+        over "Box"
+        {
+            over "Geom"
+            {
+                color3f[] primvars:displayColor = [(0.1, 0.9, 0.1)]
+            }
+        }
+    }
+}
+""")  # fmt: skip
+    meshes = LayoutMeshes()
+    first = read_geometry(tmp_path / "layout_0.usda", meshes)
+    second = read_geometry(tmp_path / "layout_1.usda", meshes)
+    assert_same(second, read_geometry(tmp_path / "layout_1.usda"))
+    assert np.allclose(second.objects[0].mesh.face_colors, (0.1, 0.9, 0.1))
+    assert np.allclose(first.objects[0].mesh.face_colors, (0.8, 0.2, 0.2))
+    assert meshes.reused == 1  # the floor, taken from layout 0
