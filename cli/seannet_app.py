@@ -151,10 +151,20 @@ def evaluate(
         float, typer.Option(help="Q: false objects of a random class, Q per true object.")
     ] = 0.0,
     noise_seed: Annotated[int, typer.Option(help="Seed of the box noise.")] = 0,
+    graphs: Annotated[
+        str,
+        typer.Option(
+            help="Scene graphs: truth (the generator's) or detected (--detector's boxes, "
+            "lifted with the depth channel; the dataset needs depth)."
+        ),
+    ] = "truth",
+    detector: Annotated[
+        Path | None, typer.Option(help="--graphs detected: the run of seannet detector train.")
+    ] = None,
 ) -> None:
     """Triplet accuracy (overall, per room, per tier), similarity heat maps, threshold;
-    optionally with the box overlap (--boxes) or the learned box kernel (--box-kernel), or
-    under labeler / detector box noise."""
+    optionally with the box overlap (--boxes) or the learned box kernel (--box-kernel), under
+    labeler / detector box noise, or with a trained detector's graphs (--graphs detected)."""
     from seannet.data.box_noise import BoxNoise
     from seannet.evaluation.run_eval import eval_file, evaluate_run
 
@@ -162,10 +172,40 @@ def evaluate(
         raise typer.BadParameter("give --boxes or --box-kernel, not both")
     term = "+boxes" if boxes else "+box-kernel" if box_kernel else ""
     noise = BoxNoise(jitter=box_noise, drop=drop, spurious=spurious, seed=noise_seed)
+    if graphs not in ("truth", "detected"):
+        raise typer.BadParameter(f"--graphs {graphs}: expected truth or detected")
+    if (graphs == "detected") != (detector is not None):
+        raise typer.BadParameter("--graphs detected and --detector RUN go together")
+    if detector is not None:
+        if noise.active:
+            raise typer.BadParameter("--graphs detected takes no synthetic box noise")
+        noise = _detected(detector, data, split, box_kernel)
     evaluate_run(run, data, split=split, boxes=term, noise=noise)
     written = eval_file(run, split, boxes=term, noise=noise)
     console.print(written.with_suffix(".md").read_text())
     console.print(f"wrote {written}")
+
+
+def _detected(detector: Path, data: Path, split: str, box_kernel: bool):  # noqa: ANN202
+    """The detected graphs of the splits an evaluation reads (train too for the kernel)."""
+    from rich.progress import Progress
+
+    from seannet.detection.graphs import detected_graphs
+    from seannet.detection.train import load_detector
+
+    trained = load_detector(detector, data)
+    with Progress(console=console, transient=True) as bar:
+        task = bar.add_task("detect", total=None)
+        graphs = detected_graphs(
+            trained,
+            data,
+            [split, *(["train"] if box_kernel else [])],
+            progress=lambda name, done, total: bar.update(
+                task, description=f"detect {name}", completed=done, total=total
+            ),
+        )
+    console.print(f"detected graphs: score >= {graphs.threshold:g} (best F1 on val)")
+    return graphs
 
 
 @app.command()
@@ -631,6 +671,97 @@ def leaderboard(
     if out is not None:
         atomic_write_text(out, text)
         console.print(f"wrote {out}")
+
+
+detector_app = typer.Typer(
+    help="A detector trained on the dataset's COCO export: boxes from pixels, so a localizer "
+    "can be measured without the generator's annotations.",
+    no_args_is_help=True,
+)
+app.add_typer(detector_app, name="detector")
+
+
+@detector_app.command(name="train")
+def detector_train(
+    data: Data,
+    out: Annotated[Path, typer.Option("--out", help="The detector's run directory.")],
+    epochs: Annotated[int, typer.Option(help="Epochs over the train views.")] = 8,
+    size: Annotated[int, typer.Option(help="Views are resized to SIZE x SIZE.")] = 320,
+    minutes: Annotated[
+        float | None, typer.Option(help="Stop here: no epoch starts that cannot finish.")
+    ] = None,
+    val_views: Annotated[
+        int, typer.Option(help="Val views scored after each epoch (0: all).")
+    ] = 400,
+    imagenet: Annotated[
+        bool,
+        typer.Option(
+            help="Start from EfficientNet-Lite0's ImageNet weights (the `lite` extra); "
+            "--no-imagenet: random init."
+        ),
+    ] = True,
+    seed: Annotated[int, typer.Option(help="Seed of init, batch order and flips.")] = 0,
+) -> None:
+    """Train FCOS on EfficientNet-Lite0 on the train views; the epoch is chosen by val AP50."""
+    from rich.progress import Progress
+
+    from seannet.detection.model import DetectorConfig
+    from seannet.detection.train import train_detector
+    from seannet.weights import LITE0_WEIGHTS
+
+    config = DetectorConfig(
+        size=size,
+        epochs=epochs,
+        val_views=val_views,
+        seed=seed,
+        pretrained=LITE0_WEIGHTS if imagenet else None,
+    )
+    with Progress(console=console, transient=True) as bar:
+        task = bar.add_task("detector", total=None)
+
+        def show(phase: str, done: int, total: int, metrics: dict[str, float]) -> None:
+            text = " ".join(f"{k} {v:.3g}" for k, v in metrics.items())
+            bar.update(task, description=f"{phase} {text}", completed=done, total=total)
+
+        record = train_detector(config, data, out, minutes=minutes, progress=show)
+    table = Table(title=f"detector on {data} -> {out}")
+    for column in ("epoch", "loss", "val AP", "val AP50", "s"):
+        table.add_column(column, justify="right")
+    for e in record["epochs"]:
+        table.add_row(
+            str(e["epoch"]),
+            f"{e['loss']:.3f}",
+            f"{e['val_ap']:.3f}",
+            f"{e['val_ap50']:.3f}",
+            f"{e['seconds']:.0f}",
+        )
+    console.print(table)
+    console.print(f"chosen epoch {record['best_epoch']} (val AP50); stopped by {record['stopped']}")
+
+
+@detector_app.command(name="eval")
+def detector_eval(
+    run: Annotated[Path, typer.Argument(help="The detector's run directory.")],
+    data: Data,
+    split: Annotated[str, typer.Option(help="Split to score.")] = "test",
+) -> None:
+    """COCO box AP and AP50 (pycocotools) on a split, AP50 per class; writes
+    RUN/eval_<split>.json."""
+    import json
+
+    from seannet.detection.coco_views import CocoViews
+    from seannet.detection.train import export_for, load_detector
+    from sgdata.fileio import atomic_write_text
+
+    trained = load_detector(run, data)
+    score = trained.score(CocoViews(export_for(data, run), split))
+    atomic_write_text(run / f"eval_{split}.json", json.dumps(score.to_dict(), indent=1) + "\n")
+    table = Table(title=f"detector {run} on {split}: AP {score.ap:.3f}, AP50 {score.ap50:.3f}")
+    table.add_column("class")
+    table.add_column("AP50", justify="right")
+    for name, ap50 in sorted(score.ap50_per_class.items(), key=lambda kv: kv[1]):
+        table.add_row(name, f"{ap50:.3f}")
+    console.print(table)
 
 
 results_app = typer.Typer(

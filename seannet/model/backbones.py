@@ -30,6 +30,7 @@ __all__ = [
     "ResNetSplit",
     "resnet_c4",
     "efficientnet_lite0_c4",
+    "Lite0Pyramid",
     "image_encoder",
 ]
 
@@ -166,6 +167,28 @@ def efficientnet_lite0_c4(
     Raises:
         ModelError: the ``lite`` extra is not installed, or the weights fail their checks.
     """
+    net, blocks = _lite0_blocks(pretrained, sha256)
+    n = len(blocks)
+    stride, cut = 2, n  # the stem halves the input; cut before the block that reaches 32
+    for i, block in enumerate(net._blocks):
+        s = _block_stride(block)
+        if stride * s > C4_STRIDE:
+            cut = i
+            break
+        stride *= s
+    backbone = nn.Sequential(net._conv_stem, net._bn0, nn.ReLU6(), *blocks[:cut])
+    stage5 = nn.Sequential(*blocks[cut:], net._conv_head, net._bn1, nn.ReLU6())
+    head = nn.Sequential(stage5, nn.AdaptiveAvgPool2d(1), nn.Flatten(1))
+    c4_channels = int(net._blocks[cut - 1]._block_args.output_filters)
+    head_dim = int(net._conv_head.out_channels)
+    return ResNetSplit(backbone, head, c4_channels=c4_channels, head_dim=head_dim)
+
+
+def _lite0_blocks(
+    pretrained: str | Path | None, sha256: str | None
+) -> tuple[nn.Module, list[_LiteBlock]]:
+    """The package's EfficientNet-Lite0 (weights loaded when asked) and its MBConv blocks,
+    each wrapped with the drop-connect rate the original model gives it."""
     try:
         from efficientnet_lite_pytorch import EfficientNet
     except ImportError:
@@ -183,21 +206,49 @@ def efficientnet_lite0_c4(
         load_pretrained(net, path, arch="efficientnet_lite0", sha256=sha256 or LITE0_SHA256)
     rate = float(net._global_params.drop_connect_rate or 0.0)
     n = len(net._blocks)
-    blocks = [_LiteBlock(b, rate * i / n) for i, b in enumerate(net._blocks)]
-    stride, cut = 2, n  # the stem halves the input; cut before the block that reaches 32
-    for i, block in enumerate(net._blocks):
-        s = block._block_args.stride
-        s = int(s[0] if isinstance(s, list | tuple) else s)
-        if stride * s > C4_STRIDE:
-            cut = i
-            break
-        stride *= s
-    backbone = nn.Sequential(net._conv_stem, net._bn0, nn.ReLU6(), *blocks[:cut])
-    stage5 = nn.Sequential(*blocks[cut:], net._conv_head, net._bn1, nn.ReLU6())
-    head = nn.Sequential(stage5, nn.AdaptiveAvgPool2d(1), nn.Flatten(1))
-    c4_channels = int(net._blocks[cut - 1]._block_args.output_filters)
-    head_dim = int(net._conv_head.out_channels)
-    return ResNetSplit(backbone, head, c4_channels=c4_channels, head_dim=head_dim)
+    return net, [_LiteBlock(b, rate * i / n) for i, b in enumerate(net._blocks)]
+
+
+def _block_stride(block: nn.Module) -> int:
+    """How much an MBConv block of the package shrinks its input."""
+    s = block._block_args.stride
+    return int(s[0] if isinstance(s, list | tuple) else s)
+
+
+class Lite0Pyramid(nn.Module):
+    """EfficientNet-Lite0's feature maps at strides 8, 16 and 32 (40, 112 and 320 channels):
+    the multi-scale input a detector's feature pyramid takes. Built as
+    :func:`efficientnet_lite0_c4` builds its network (same weights, same drop-connect)."""
+
+    STRIDES = (8, 16, 32)
+
+    def __init__(self, *, pretrained: str | Path | None = None, sha256: str | None = None):
+        super().__init__()
+        net, blocks = _lite0_blocks(pretrained, sha256)
+        self.stem = nn.Sequential(net._conv_stem, net._bn0, nn.ReLU6())
+        stages: list[list[_LiteBlock]] = [[]]
+        stride = 2
+        self.channels: list[int] = []
+        for block, wrapped in zip(net._blocks, blocks, strict=True):
+            s = _block_stride(block)
+            if s > 1 and stride in self.STRIDES:  # the stage of this stride ends here
+                self.channels.append(int(stages[-1][-1].block._block_args.output_filters))
+                stages.append([])
+            stride *= s
+            stages[-1].append(wrapped)
+        self.channels.append(int(net._blocks[-1]._block_args.output_filters))
+        # stages[0] runs from stride 2 to 8 and gives the stride-8 map; the others one each
+        self.stages = nn.ModuleList(nn.Sequential(*stage) for stage in stages)
+        if len(self.stages) != len(self.STRIDES):
+            raise ModelError(f"EfficientNet-Lite0 gave {len(self.stages)} stages; expected 3")
+
+    def forward(self, x: Tensor) -> list[Tensor]:
+        out = []
+        x = self.stem(x)
+        for stage in self.stages:
+            x = stage(x)
+            out.append(x)
+        return out
 
 
 def image_encoder(

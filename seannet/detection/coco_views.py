@@ -1,0 +1,90 @@
+"""The views of one split of a COCO export (``sgdata export coco``) as detector inputs and
+targets: what the detector trains and is scored on, from the files any other tool reads."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+from PIL import Image
+from torch import Tensor
+
+from seannet.errors import DataError
+
+__all__ = ["CocoViews", "ViewTarget", "collate_detection"]
+
+ViewTarget = dict[str, Tensor]  # torchvision's: "boxes" (n, 4) xyxy pixels, "labels" (n,)
+
+
+@dataclass
+class CocoViews(torch.utils.data.Dataset):
+    """Split ``split`` of the COCO export in ``folder``: item i is image i (by image id) as a
+    (3, H, W) float tensor on [0, 1] and its target; ``flip`` mirrors an item left-right
+    when ``flip(i)`` says so (training's augmentation, drawn by the caller's generator)."""
+
+    folder: Path
+    split: str
+
+    def __post_init__(self) -> None:
+        self.folder = Path(self.folder)
+        path = self.folder / "annotations" / f"instances_{self.split}.json"
+        try:
+            document = json.loads(path.read_text())
+        except (OSError, ValueError) as exc:
+            raise DataError(f"{path}: not a readable COCO file ({exc})") from None
+        self.document: dict[str, Any] = document
+        self.images = sorted(document["images"], key=lambda im: im["id"])
+        self.categories = sorted(c["id"] for c in document["categories"])
+        if self.categories != list(range(1, len(self.categories) + 1)):
+            raise DataError(f"{path}: category ids must be 1..N, as sgdata export coco writes")
+        boxes: dict[int, list[list[float]]] = {im["id"]: [] for im in self.images}
+        labels: dict[int, list[int]] = {im["id"]: [] for im in self.images}
+        for ann in document["annotations"]:
+            x, y, w, h = ann["bbox"]
+            if w > 0 and h > 0:  # a box of no area teaches nothing and breaks the GIoU loss
+                boxes[ann["image_id"]].append([x, y, x + w, y + h])
+                labels[ann["image_id"]].append(ann["category_id"])
+        self._boxes = boxes
+        self._labels = labels
+        self.flips: np.ndarray | None = None  # per item: mirror it (set per epoch)
+
+    @property
+    def num_classes(self) -> int:
+        return len(self.categories)
+
+    def __len__(self) -> int:
+        return len(self.images)
+
+    def image(self, i: int) -> Tensor:
+        """Image ``i`` as (3, H, W) float32 on [0, 1]."""
+        path = self.folder / "images" / self.split / self.images[i]["file_name"]
+        try:
+            with Image.open(path) as im:
+                pixels = np.asarray(im.convert("RGB"))
+        except OSError as exc:
+            raise DataError(f"{path}: cannot read the image ({exc})") from None
+        return torch.from_numpy(pixels.copy()).permute(2, 0, 1).float().div_(255.0)
+
+    def __getitem__(self, i: int) -> tuple[Tensor, ViewTarget]:
+        image_id = self.images[i]["id"]
+        image = self.image(i)
+        boxes = torch.tensor(self._boxes[image_id], dtype=torch.float32).reshape(-1, 4)
+        labels = torch.tensor(self._labels[image_id], dtype=torch.int64)
+        if self.flips is not None and self.flips[i]:
+            width = image.shape[-1]
+            image = image.flip(-1)
+            boxes = torch.stack(
+                (width - boxes[:, 2], boxes[:, 1], width - boxes[:, 0], boxes[:, 3]), dim=1
+            )
+        return image, {"boxes": boxes, "labels": labels}
+
+
+def collate_detection(
+    items: list[tuple[Tensor, ViewTarget]],
+) -> tuple[list[Tensor], list[ViewTarget]]:
+    """torchvision detectors take lists of images and targets, not stacked tensors."""
+    return [image for image, _ in items], [target for _, target in items]

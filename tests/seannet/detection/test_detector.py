@@ -1,0 +1,99 @@
+"""The detector in the loop on the mini dataset with depth: trained on its COCO export, scored
+by pycocotools, its graphs fed to a localizer's evaluation in place of the generator's."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+
+from tests.cli_runner import run_cli
+
+
+@pytest.fixture(scope="module")
+def detector_run(tmp_path_factory: pytest.TempPathFactory, channels_dataset: Path) -> Path:
+    run = tmp_path_factory.mktemp("detector") / "run"
+    done = run_cli(
+        "seannet",
+        "detector",
+        "train",
+        "--data",
+        channels_dataset,
+        "--out",
+        run,
+        "--epochs",
+        "2",
+        "--size",
+        "96",
+        "--val-views",
+        "0",
+    )
+    assert done.returncode == 0, done.stderr
+    return run
+
+
+def test_a_trained_detector_records_its_curve_and_is_scored_by_pycocotools(
+    detector_run: Path, channels_dataset: Path
+) -> None:
+    record = json.loads((detector_run / "detector.json").read_text())
+    assert [e["epoch"] for e in record["epochs"]] == [1, 2]
+    assert record["best_epoch"] in (1, 2)
+    assert record["config"]["pretrained"] == "imagenet-lite0"
+    assert (detector_run / "coco" / "annotations" / "instances_train.json").is_file()
+    done = run_cli("seannet", "detector", "eval", detector_run, "--data", channels_dataset)
+    assert done.returncode == 0, done.stderr
+    score = json.loads((detector_run / "eval_test.json").read_text())
+    truth = json.loads((detector_run / "coco/annotations/instances_test.json").read_text())
+    assert score["views"] == len(truth["images"])
+    assert 0.0 <= score["ap"] <= score["ap50"] <= 1.0
+    # every class with a true box in the test views has its AP50, and only those
+    names = {c["id"]: c["name"] for c in truth["categories"]}
+    assert set(score["ap50_per_class"]) == {names[a["category_id"]] for a in truth["annotations"]}
+
+
+def test_eval_with_detected_graphs_is_its_own_file_and_reuses_the_detections(
+    tmp_path: Path, detector_run: Path, channels_dataset: Path, localizer_run: Path
+) -> None:
+    run = tmp_path / "run"
+    shutil.copytree(localizer_run, run)
+    args = ("eval", run, "--data", channels_dataset, "--graphs", "detected", "--detector")
+    done = run_cli("seannet", *args, detector_run)
+    assert done.returncode == 0, done.stderr
+    written = sorted(p.name for p in run.glob("eval_test_detected-*.json"))
+    assert len(written) == 1, sorted(p.name for p in run.iterdir())
+    chosen = json.loads(next((detector_run / "graphs").glob("*/threshold.json")).read_text())
+    assert written[0].endswith(f"-t{chosen['threshold']:g}.json")
+    assert f"detected-{chosen['detector'][:8]}-" in written[0]
+    assert max(chosen["val_f1"].values()) == chosen["val_f1"][f"{chosen['threshold']:g}"]
+    cached = sorted((detector_run / "graphs").glob("*/*.parquet"))
+    assert [p.name for p in cached] == ["test.parquet", "val.parquet"]
+    stamps = [p.stat().st_mtime_ns for p in cached]
+    again = run_cli("seannet", *args, detector_run)
+    assert again.returncode == 0, again.stderr
+    assert [p.stat().st_mtime_ns for p in cached] == stamps  # read from the cache
+
+
+def test_detected_graphs_need_depth_and_a_detector_run(
+    tmp_path: Path, detector_run: Path, mini_dataset: Path, localizer_run: Path
+) -> None:
+    run = tmp_path / "run"
+    shutil.copytree(localizer_run, run)
+    alone = run_cli("seannet", "eval", run, "--data", mini_dataset, "--graphs", "detected")
+    assert alone.returncode == 2 and "--detector RUN" in alone.stderr
+    no_depth = run_cli(
+        "seannet",
+        "eval",
+        run,
+        "--data",
+        mini_dataset,
+        "--graphs",
+        "detected",
+        "--detector",
+        detector_run,
+    )
+    assert no_depth.returncode == 2
+    assert "no depth" in no_depth.stderr and "[outputs] depth = true" in no_depth.stderr
+    assert len(no_depth.stderr.strip().splitlines()) == 1, no_depth.stderr
+    assert not list(run.glob("eval_test_detected*"))
