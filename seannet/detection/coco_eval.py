@@ -1,5 +1,5 @@
 """COCO box AP of a detector on a split, by pycocotools (the reference implementation), with
-AP50 per class: the figures the detector's card and its closing table quote."""
+AP50 per class: the figures docs/detector.md quotes."""
 
 from __future__ import annotations
 
