@@ -186,7 +186,7 @@ def evaluate(
     console.print(f"wrote {written}")
 
 
-def _detected(detector: Path, data: Path, split: str, box_kernel: bool):  # noqa: ANN202
+def _detected(detector: Path, data: object, split: str, box_kernel: bool):  # noqa: ANN202
     """The detected graphs of the splits an evaluation reads (train too for the kernel)."""
     from rich.progress import Progress
 
@@ -604,10 +604,18 @@ def benchmark(
             "and give each method's accuracy on the triplets the views decide beside all.",
         ),
     ] = False,
+    detector: Annotated[
+        Path | None,
+        typer.Option(
+            help="seannet detector train run: the box-noise sweep of methods that read boxes "
+            "gains a row with the detector's scene graphs (the dataset needs depth)."
+        ),
+    ] = None,
 ) -> None:
     """DESIGN §12's protocol for any method: choices on val, test once, the change sweep, box
-    noise, cost, with --navigator the navigation test and with --covisibility the accuracy
-    on the triplets the views decide; one card per method (JSON, markdown, sweep plot)."""
+    noise (with --detector, detected graphs), cost, with --navigator the navigation test and
+    with --covisibility the accuracy on the triplets the views decide; one card per method
+    (JSON, markdown, sweep plot)."""
     from functools import partial
 
     from seannet.data.opening import open_dataset
@@ -630,6 +638,10 @@ def benchmark(
             raise NavigationError("--stop-policy chooses a stop rule for --navigator: give one")
         check_val_episodes(val_episodes)
     dataset = open_dataset(data)  # every method's seeds, saved method, card and test share it
+    if detector is not None:
+        from dataclasses import replace
+
+        config = replace(config, noise=(*config.noise, _detected(detector, dataset, "test", False)))
     navigation = None
     if navigator is not None:
         test = NavigationTestConfig(episodes=episodes)

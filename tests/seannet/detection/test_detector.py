@@ -97,3 +97,28 @@ def test_detected_graphs_need_depth_and_a_detector_run(
     assert "no depth" in no_depth.stderr and "[outputs] depth = true" in no_depth.stderr
     assert len(no_depth.stderr.strip().splitlines()) == 1, no_depth.stderr
     assert not list(run.glob("eval_test_detected*"))
+
+
+def test_the_benchmark_sweep_gains_a_detected_graphs_row(
+    tmp_path: Path, detector_run: Path, channels_dataset: Path
+) -> None:
+    done = run_cli(
+        "seannet",
+        "benchmark",
+        "--data",
+        channels_dataset,
+        "--methods",
+        "boxes-overlap",
+        "--out",
+        tmp_path / "cards",
+        "--seeds",
+        "0",
+        "--detector",
+        detector_run,
+    )
+    assert done.returncode == 0, done.stderr
+    card = json.loads(next((tmp_path / "cards").rglob("card.json")).read_text())
+    labels = [n["label"] for n in card["summary"]["box_noise"]]
+    assert labels[-1].startswith("detected-") and len(labels) == 6, labels
+    assert 0.0 <= card["summary"]["box_noise"][-1]["accuracy"] <= 1.0
+    assert labels[-1] in (tmp_path / "cards" / "boxes-overlap" / "card.md").read_text()
