@@ -69,12 +69,14 @@ def run_one(
         config = load_config(preset or config_path)
         phases: dict[str, float] = {}
         peaks: list[float] = []  # the views phase's worker peaks, room by room
+        last: dict[int, object] = {}  # each worker's last report of the views phase
 
         def progress(step) -> None:  # noqa: ANN001
             phases[step.phase] = step.elapsed
             phases[f"{step.phase}_views"] = step.views
             if step.phase == "views":
                 peaks.append(step.worker_peak_mib)
+                last[step.worker_pid] = step
 
         clock = StageClock() if profile else None
         start = time.perf_counter()
@@ -102,6 +104,13 @@ def run_one(
         # the largest worker's peak once 3 rooms were rendered, and once all were: flat if equal
         "worker_peak_after_3_mib": round(max(peaks[:3]), 1),
         "worker_peak_after_all_mib": round(max(peaks), 1),
+        # contention (issue 55): each worker's threads by origin at its end, and the context
+        # switches of all workers (both phases, start-up included) per view
+        "worker_threads_by_origin": [step.worker_threads_by_origin for step in last.values()],
+        "context_switches_per_view": [
+            round(sum(step.worker_context_switches[k] for step in last.values()) / views, 1)
+            for k in (0, 1)
+        ],
     } | stages
 
 
@@ -141,10 +150,18 @@ def main() -> None:
             print(rows[-1], flush=True)
     print()
     header = ("rooms", "workers", "views", "wall (s)", "views/s", "render views/s",
-              "main peak (MiB)", "worker peak (MiB)")  # fmt: skip
+              "main peak (MiB)", "worker peak (MiB)", "switches / view (vol, invol)")  # fmt: skip
     keys = ("rooms", "workers", "views", "wall_s", "views_per_s", "render_views_per_s",
-            "main_peak_mib", "worker_peak_mib")  # fmt: skip
+            "main_peak_mib", "worker_peak_mib", "context_switches_per_view")  # fmt: skip
     print("\n".join(table(header, ([r[k] for k in keys] for r in rows))))
+    for r in rows:
+        origins = "; ".join(
+            ", ".join(f"{n} {c}" for n, c in worker.items())
+            for worker in r["worker_threads_by_origin"]
+        )
+        print(
+            f"{r['rooms']} rooms, {r['workers']} worker(s): threads by origin per worker: {origins}"
+        )
     for rooms in sorted({r["rooms"] for r in rows}):
         by_workers = {r["workers"]: r for r in rows if r["rooms"] == rooms}
         if 1 in by_workers and 2 in by_workers:

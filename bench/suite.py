@@ -203,6 +203,7 @@ def _generate_section(result: dict[str, Any]) -> list[str]:
                 f"{max(r[k] for r in rs):.0f}"
                 for k in ("worker_peak_after_3_mib", "worker_peak_after_all_mib")
             ),
+            _contention(rs),
             "",
         )
         for (label, _, _), rs, b in zip(GENERATE_RUNS, rounds, best, strict=True)
@@ -212,7 +213,7 @@ def _generate_section(result: dict[str, Any]) -> list[str]:
         pairs = zip(rounds[over], rounds[under], strict=True)
         each = [a["views_per_s"] / b["views_per_s"] for a, b in pairs]
         spread = f" (rounds {min(each):.2f}x to {max(each):.2f}x)" if len(each) > 1 else ""
-        return f"**{name}**", f"{best[over] / best[under]:.2f}x{spread}", "", AIMS[name]
+        return f"**{name}**", f"{best[over] / best[under]:.2f}x{spread}", "", "", AIMS[name]
 
     rendered = result["render"]["pipeline_textured"]
     alone = [r["views_per_s"] / rendered for r in rounds[0]]
@@ -224,12 +225,30 @@ def _generate_section(result: dict[str, Any]) -> list[str]:
             "annotated views/s)",
             f"{best[0] / rendered:.2f}x (rounds {min(alone):.2f}x to {max(alone):.2f}x)",
             "",
+            "",
             AIMS["1 worker / rendering alone"],
         ),
     ]
     header = ("run (each round's wall time)", "fastest round",
-              "worker peak after 3 rooms / all (MiB)", "aim")  # fmt: skip
+              "worker peak after 3 rooms / all (MiB)",
+              "per worker: threads; context switches a view (voluntary / involuntary)",
+              "aim")  # fmt: skip
     return table(header, rows)
+
+
+def _contention(rounds: list[dict[str, Any]]) -> str:
+    """A configuration's threads per worker (the first round's, by origin) and its context
+    switches a view (each round's), or nothing for runs measured before they were counted."""
+    if "context_switches_per_view" not in rounds[0]:
+        return ""
+    workers = rounds[0]["worker_threads_by_origin"]
+    threads = " · ".join(
+        f"{sum(w.values())} ({', '.join(f'{n} {c}' for n, c in w.items())})" for w in workers
+    )
+    switches = ", ".join(
+        "{} / {}".format(*(f"{v:.0f}" for v in r["context_switches_per_view"])) for r in rounds
+    )
+    return f"{threads}; {switches}"
 
 
 def _profile_commands(args: argparse.Namespace, tiny: Path) -> list[list[str]]:

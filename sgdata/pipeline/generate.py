@@ -19,7 +19,7 @@ import json
 import shutil
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from sgdata.dataset.paths import MANIFEST, OUTPUTS, SCENE_TEXTURES, SPLITS, scene_dir
@@ -56,6 +56,11 @@ class GenerateProgress:
     # its threads when it finished (native ones included)
     worker_peak_mib: float = 0.0
     worker_threads: int = 0
+    worker_pid: int = 0
+    # its threads by origin (sgdata.pipeline.worker_state.threads_by_origin), and its context
+    # switches so far: (voluntary, involuntary)
+    worker_threads_by_origin: dict[str, int] = field(default_factory=dict)
+    worker_context_switches: tuple[int, int] = (0, 0)
 
 
 def plan_rooms(config: GenerateConfig) -> list[RoomTask]:
@@ -313,10 +318,16 @@ def _run_phase(
             clock.add(stages)
             booked += sum(seconds for seconds, _ in stages.values())
         if progress is not None:
-            peak = float(result.get("peak_rss_mib", 0.0))
-            threads = int(result.get("threads", 0))
-            elapsed = time.perf_counter() - start
-            progress(GenerateProgress(phase, done, total, views, elapsed, peak, threads))
+            progress(
+                GenerateProgress(
+                    phase, done, total, views, time.perf_counter() - start,
+                    worker_peak_mib=float(result.get("peak_rss_mib", 0.0)),
+                    worker_threads=int(result.get("threads", 0)),
+                    worker_pid=int(result.get("pid", 0)),
+                    worker_threads_by_origin=dict(result.get("threads_by_origin", {})),
+                    worker_context_switches=tuple(result.get("context_switches", (0, 0))),
+                )
+            )  # fmt: skip
     if clock is not None and jobs:  # the workers' time no task claimed
         busy = min(engine["workers"], len(jobs)) * (time.perf_counter() - start)
         clock.book(phase, OUTSIDE, max(0.0, busy - booked))

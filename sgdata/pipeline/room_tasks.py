@@ -7,9 +7,6 @@ completion in the ledger last, so a task killed half-way leaves nothing that cou
 from __future__ import annotations
 
 import json
-import re
-import resource
-import threading
 from collections import defaultdict
 from dataclasses import dataclass
 from pathlib import Path
@@ -18,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 from sgdata.dataset.paths import observations_path, scene_dir
 from sgdata.errors import DatasetError
 from sgdata.pipeline.ledger import read_record, scene_record, views_record, write_record
+from sgdata.pipeline.worker_state import worker_state
 from sgdata.scene_files import layout_file, room_file
 from sgdata.seeds import rng_for, view_seed
 from sgdata.stage_clock import NO_CLOCK, OTHER, Clock, StageClock
@@ -30,10 +28,8 @@ __all__ = [
     "COMMAND",
     "OUTSIDE",
     "RoomTask",
-    "peak_rss_mib",
     "render_room_views",
     "stage_order",
-    "worker_threads",
     "write_room_scenes",
 ]
 
@@ -87,7 +83,8 @@ def write_room_scenes(
     """Phase 1 of a room: USD room and layouts, and the reachable cells of every layout.
 
     The result holds the views rendered (none here), the worker's peak memory so far
-    (``peak_rss_mib``) and its threads now (``threads``).
+    (``peak_rss_mib``), its threads now (``threads``, ``threads_by_origin``) and context
+    switches so far (:func:`sgdata.pipeline.worker_state.worker_state`).
 
     With a ``clock`` (:class:`sgdata.stage_clock.StageClock`) its steps are timed as
     :func:`stage_order` and the result carries the clock's totals under ``"stages"``.
@@ -95,7 +92,7 @@ def write_room_scenes(
     clock = clock or NO_CLOCK
     with clock.phase(SCENES), clock.stage(OTHER):
         _write_room_scenes(task, config, root, clock)
-    return {"views": 0, **_worker_state(), **_stages(clock)}
+    return {"views": 0, **worker_state(), **_stages(clock)}
 
 
 def _write_room_scenes(task: RoomTask, config: GenerateConfig, root: Path, clock: Clock) -> None:
@@ -167,15 +164,16 @@ def render_room_views(
 ) -> dict:
     """Phase 3 of a room: render the referenced views and write the room's shard.
 
-    The result holds the views rendered, the worker's peak memory so far (``peak_rss_mib``)
-    and its threads now (``threads``). With a ``clock`` its steps are timed as
+    The result holds the views rendered and what the worker says of itself
+    (:func:`sgdata.pipeline.worker_state.worker_state`: peak memory, threads, context
+    switches). With a ``clock`` its steps are timed as
     :func:`stage_order` (the annotator's too) and the result carries the clock's totals under
     ``"stages"``.
     """
     clock = clock or NO_CLOCK
     with clock.phase(VIEWS), clock.stage(OTHER):
         views = _render_room_views(task, poses, config, root, clock)
-    return {"views": views, **_worker_state(), **_stages(clock)}
+    return {"views": views, **worker_state(), **_stages(clock)}
 
 
 def _render_room_views(
@@ -234,27 +232,6 @@ def _render_room_views(
     with clock.stage("ledger"):
         write_record(views_record(root, task.room_id), record)
     return len(encoder)
-
-
-def peak_rss_mib() -> float:
-    """This process's peak resident memory so far, in MiB (Linux reports KiB)."""
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-
-
-def worker_threads() -> int:
-    """This process's threads, native ones included (the GL driver's, Arrow's, OpenMP's):
-    Linux's count, else Python's own."""
-    try:
-        status = Path("/proc/self/status").read_text()
-    except OSError:
-        return threading.active_count()
-    found = re.search(r"^Threads:\s+(\d+)", status, re.MULTILINE)
-    return int(found.group(1)) if found else threading.active_count()
-
-
-def _worker_state() -> dict:
-    """What a task's result says of the worker that ran it: its peak memory and threads."""
-    return {"peak_rss_mib": peak_rss_mib(), "threads": worker_threads()}
 
 
 def _encoding_pool() -> Any:

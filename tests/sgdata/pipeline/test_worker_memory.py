@@ -42,11 +42,15 @@ def test_a_workers_memory_and_threads_are_flat_across_rooms(tmp_path: Path) -> N
     config.write_text(TOML)
     peaks: list[float] = []
     threads: list[int] = []
+    origins: list[dict[str, int]] = []
+    switches: list[tuple[int, int]] = []
 
     def progress(step: GenerateProgress) -> None:
         if step.phase == "views":
             peaks.append(step.worker_peak_mib)
             threads.append(step.worker_threads)
+            origins.append(step.worker_threads_by_origin)
+            switches.append(step.worker_context_switches)
 
     generate_dataset(load_config(config), tmp_path / "data", workers=1, progress=progress)
     assert len(peaks) == 12
@@ -54,3 +58,9 @@ def test_a_workers_memory_and_threads_are_flat_across_rooms(tmp_path: Path) -> N
     after_3, after_12 = peaks[2], peaks[-1]
     assert after_12 - after_3 < 12.0, peaks
     assert threads[0] > 1 and threads == [threads[0]] * 12, threads
+    # by origin: the same pools after every room, and they add up to the kernel's count
+    assert origins == [origins[0]] * 12 and sum(origins[0].values()) == threads[0], origins
+    assert origins[0]["MainThread"] == 1 and origins[0]["sgdata-encode"] == 1, origins[0]
+    # context switches only grow, and rendering twelve rooms takes some
+    assert all(b[0] >= a[0] and b[1] >= a[1] for a, b in zip(switches, switches[1:], strict=False))
+    assert sum(switches[-1]) > sum(switches[0]) > 0, switches
