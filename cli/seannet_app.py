@@ -702,6 +702,9 @@ def detector_train(
     minutes: Annotated[
         float | None, typer.Option(help="Stop here: no epoch starts that cannot finish.")
     ] = None,
+    epoch_views: Annotated[
+        int, typer.Option(help="Train views each epoch draws (0: all of them).")
+    ] = 0,
     val_views: Annotated[
         int, typer.Option(help="Val views scored after each epoch (0: all).")
     ] = 400,
@@ -724,6 +727,7 @@ def detector_train(
     config = DetectorConfig(
         size=size,
         epochs=epochs,
+        epoch_views=epoch_views,
         val_views=val_views,
         seed=seed,
         pretrained=LITE0_WEIGHTS if imagenet else None,

@@ -38,6 +38,7 @@ class DetectorConfig:
     lr: float = 0.01
     weight_decay: float = 1e-4
     warmup_steps: int = 200
+    epoch_views: int = 0  # train views an epoch draws (0: all): more, shorter epochs to choose from
     val_views: int = 400  # val views scored after each epoch to choose the epoch (0: all)
     seed: int = 0
 
@@ -45,6 +46,9 @@ class DetectorConfig:
         for name in ("size", "fpn_channels", "head_convs", "epochs", "batch_size"):
             if getattr(self, name) < 1:
                 raise ModelError(f"detector {name}={getattr(self, name)}; expected >= 1")
+        for name in ("epoch_views", "val_views"):
+            if getattr(self, name) < 0:
+                raise ModelError(f"detector {name}={getattr(self, name)}; expected >= 0 (0: all)")
         if self.fpn_channels % 32:
             raise ModelError(
                 f"detector fpn_channels={self.fpn_channels}; expected a multiple of 32 "

@@ -94,7 +94,8 @@ def train_detector(
     optimiser = torch.optim.SGD(
         params, lr=config.lr, momentum=0.9, weight_decay=config.weight_decay
     )
-    steps_per_epoch = math.ceil(len(train_views) / config.batch_size)
+    per_epoch = min(config.epoch_views or len(train_views), len(train_views))
+    steps_per_epoch = math.ceil(per_epoch / config.batch_size)
     total = steps_per_epoch * config.epochs
     val = _val_indices(val_views, config.val_views, config.seed)
     rng = np.random.default_rng([config.seed, 0])
@@ -111,11 +112,11 @@ def train_detector(
     for epoch in range(1, config.epochs + 1):
         epoch_start = time.monotonic()
         if minutes is not None and record["epochs"]:
-            per_epoch = max(e["seconds"] for e in record["epochs"])
-            if epoch_start - started + per_epoch > minutes * 60:
+            longest = max(e["seconds"] for e in record["epochs"])
+            if epoch_start - started + longest > minutes * 60:
                 record["stopped"] = "time"
                 break
-        order = rng.permutation(len(train_views))
+        order = rng.permutation(len(train_views))[:per_epoch]
         train_views.flips = rng.random(len(train_views)) < 0.5
         model.train()
         losses: list[float] = []
