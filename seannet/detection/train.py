@@ -44,12 +44,16 @@ Progress = Callable[[str, int, int, dict[str, float]], None]
 
 
 def export_for(data: DataSource, run: Path) -> Path:
-    """The run's COCO export of ``data`` (every split), written once."""
+    """The run's COCO export of ``data`` (every split), written once per dataset: an export
+    of another dataset (its manifest's sha256 differs) is replaced."""
     from sgdata.label.coco_export import export_coco
 
+    ds = open_dataset(data)
     folder = run / COCO
-    if not (folder / "annotations").is_dir():
-        export_coco(open_dataset(data).root, folder, force=True)
+    marker = run / f"{COCO}.manifest_sha256"
+    if not marker.is_file() or marker.read_text().strip() != ds.manifest_sha256:
+        export_coco(ds.root, folder, force=True)
+        atomic_write_text(marker, ds.manifest_sha256 + "\n")
     return folder
 
 

@@ -3,6 +3,7 @@ by pycocotools, its graphs fed to a localizer's evaluation in place of the gener
 
 from __future__ import annotations
 
+import hashlib
 import json
 import shutil
 from pathlib import Path
@@ -42,6 +43,10 @@ def test_a_trained_detector_records_its_curve_and_is_scored_by_pycocotools(
     assert record["best_epoch"] in (1, 2)
     assert record["config"]["pretrained"] == "imagenet-lite0"
     assert (detector_run / "coco" / "annotations" / "instances_train.json").is_file()
+    # the export belongs to the dataset it was made of: another dataset's would be replaced
+    manifest = (channels_dataset / "dataset.json").read_bytes()
+    marker = (detector_run / "coco.manifest_sha256").read_text().strip()
+    assert marker == hashlib.sha256(manifest).hexdigest()
     done = run_cli("seannet", "detector", "eval", detector_run, "--data", channels_dataset)
     assert done.returncode == 0, done.stderr
     score = json.loads((detector_run / "eval_test.json").read_text())
