@@ -767,9 +767,11 @@ def detector_eval(
 
     from seannet.detection.coco_views import CocoViews
     from seannet.detection.train import export_for, load_detector
+    from seannet.provenance import append_provenance
     from sgdata.fileio import atomic_write_text
 
     trained = load_detector(run, data)
+    append_provenance(run, data, step="detector-eval")
     score = trained.score(CocoViews(export_for(data, run), split))
     atomic_write_text(run / f"eval_{split}.json", json.dumps(score.to_dict(), indent=1) + "\n")
     table = Table(title=f"detector {run} on {split}: AP {score.ap:.3f}, AP50 {score.ap50:.3f}")

@@ -4,6 +4,7 @@ by pycocotools, its graphs fed to a localizer's evaluation in place of the gener
 from __future__ import annotations
 
 import hashlib
+import importlib.util
 import json
 import shutil
 from pathlib import Path
@@ -127,3 +128,24 @@ def test_the_benchmark_sweep_gains_a_detected_graphs_row(
     assert labels[-1].startswith("detected-") and len(labels) == 6, labels
     assert 0.0 <= card["summary"]["box_noise"][-1]["accuracy"] <= 1.0
     assert labels[-1] in (tmp_path / "cards" / "boxes-overlap" / "card.md").read_text()
+    # the doc's figures come from evidence copied out of the runs, not from the runs
+    scored = run_cli("seannet", "detector", "eval", detector_run, "--data", channels_dataset)
+    assert scored.returncode == 0, scored.stderr
+    figures = _figures_script()
+    figures.RECORDS = tmp_path / "records"
+    folder = figures.record(detector_run, tmp_path / "cards", channels_dataset)
+    shutil.rmtree(tmp_path / "cards")
+    text = figures.doc()
+    assert folder.name in text
+    assert "`seannet detector eval" in text and "`seannet benchmark" in text  # the stamp
+    accuracy = card["summary"]["accuracy"]["mean"]
+    assert f"| `boxes-overlap` | {100 * accuracy:.1f} |" in text
+
+
+def _figures_script():  # noqa: ANN202 - a script, loaded from its file
+    spec = importlib.util.spec_from_file_location(
+        "detector_figures", Path(__file__).parents[3] / "scripts" / "detector_figures.py"
+    )
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
