@@ -29,6 +29,7 @@ import multiprocessing
 import os
 import signal
 import tempfile
+import time
 from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
@@ -168,9 +169,9 @@ def _noted(notes: Path, name: str, fn: Callable[..., dict], *payload: Any) -> di
 def _death(started: dict[int, BaseProcess], notes: Path) -> str:
     """One line on the worker that broke the pool: its pid, the signal, the task it was on.
     The pool stops the other workers with SIGTERM; the dead one is the one without it."""
+    deadline = time.monotonic() + 10
     for pid, process in sorted(started.items()):
-        process.join(timeout=5)
-        code = process.exitcode
+        code = _exit_code(process, deadline)
         if code is None or code >= 0 or -code == signal.SIGTERM:
             continue
         name = signal.Signals(-code).name
@@ -182,6 +183,18 @@ def _death(started: dict[int, BaseProcess], notes: Path) -> str:
             f"{hint if -code == signal.SIGKILL else ''}; rerun with --resume"
         )
     return "a worker died and its signal is unknown; rerun with --resume"
+
+
+def _exit_code(process: BaseProcess, deadline: float) -> int | None:
+    """A worker's exit code, asked again until the deadline: the pool's own thread may reap
+    the worker at the same moment, and then this side's waitpid answers ECHILD and sees the
+    code only once that thread has stored it."""
+    while True:
+        process.join(timeout=max(0.0, deadline - time.monotonic()))
+        code = process.exitcode
+        if code is not None or time.monotonic() >= deadline:
+            return code
+        time.sleep(0.02)
 
 
 def die_with_parent(parent: int) -> None:

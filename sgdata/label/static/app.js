@@ -10,7 +10,9 @@ const state = { photos: [], idx: -1, names: [], cur: null, selected: null, curre
 
 const clone = (x) => JSON.parse(JSON.stringify(x));
 const pairKey = (a, b) => Math.min(a, b) + "-" + Math.max(a, b);
+let statusCount = 0; // how many statuses were shown: a save's "saved" keeps an error shown since it began
 function setStatus(text, error) {
+  statusCount += 1;
   const el = $("#status"); el.textContent = text; el.className = error ? "error" : "";
   el.dataset.state = error ? "error" : text;
 }
@@ -98,6 +100,7 @@ function save() {
   const name = state.cur.name, cur = state.cur;
   const body = JSON.stringify({ ...cur.labels, revision: cur.revision });
   setStatus("saving");
+  const began = statusCount;
   state.saving = (async () => {
     try {
       const r = await api("/api/labels/" + encodeURIComponent(name), {
@@ -111,7 +114,7 @@ function save() {
           p.room_id = r.body.labels.room_id; p.objects = r.body.labels.objects.length;
           p.problems = r.body.problems; p.ready = r.body.problems.length === 0; renderList();
         }
-        setStatus("saved");
+        if (statusCount === began || $("#status").dataset.state !== "error") setStatus("saved");
       } else if (r.status === 409) {
         state.conflict = true; setStatus(r.body.detail + " (reload the page)", true);
       } else {
