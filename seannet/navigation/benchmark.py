@@ -58,7 +58,7 @@ from seannet.provenance import append_provenance
 from seannet.seeds import episode_seed
 from seannet.training.runs import BEST, check_same_dataset, load_checkpoint
 from sgdata.fileio import atomic_write_text, save_png, sha256_file
-from sgdata.pipeline.executors import run_tasks
+from sgdata.pipeline.executors import executor_session, run_tasks
 from sgdata.seeds import rng_for
 
 __all__ = [
@@ -145,19 +145,22 @@ def run_navigation(
     }
     labels = dict(zip(runs, run_labels(runs), strict=True))
     named = dict(zip(runs, localizers, strict=True))
-    _build_maps(named, ds.root, rooms, {r: maps / labels[r] for r in runs}, config, workers, say)
-    rules = stop_rules or {}
-    jobs = {
-        (run, room_id, case): _job(
-            settings, run, loc, labels[run], room_id, case, maps, strips, rules.get(run)
+    with executor_session(workers=workers):  # one pool for the maps and the episodes
+        _build_maps(
+            named, ds.root, rooms, {r: maps / labels[r] for r in runs}, config, workers, say
         )
-        for run, loc in named.items()
-        for room_id in rooms
-        for case in CASES
-    }
-    todo = [(job, str(ds.root), str(out)) for job in jobs.values() if _part(job, out) is None]
-    for done in run_tasks(_case_task, todo, workers=workers):
-        say(f"{done['label']}: {done['room_id']} {done['case']} done")
+        rules = stop_rules or {}
+        jobs = {
+            (run, room_id, case): _job(
+                settings, run, loc, labels[run], room_id, case, maps, strips, rules.get(run)
+            )
+            for run, loc in named.items()
+            for room_id in rooms
+            for case in CASES
+        }
+        todo = [(job, str(ds.root), str(out)) for job in jobs.values() if _part(job, out) is None]
+        for done in run_tasks(_case_task, todo, workers=workers):
+            say(f"{done['label']}: {done['room_id']} {done['case']} done")
     results: dict[str, Any] = {**settings, "config": dataclasses.asdict(config), "runs": []}
     for run, loc in named.items():
         records = [

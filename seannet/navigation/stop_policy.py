@@ -31,6 +31,7 @@ from seannet.navigation.stopping import KINDS, StopRule, choose_rule, judged
 from seannet.navigation.tables import INTERVAL, RATE_HEADER, SPLIT_HEADER, case_rates, case_row
 from seannet.provenance import append_provenance, stamp
 from sgdata.fileio import atomic_write_text
+from sgdata.pipeline.executors import executor_session
 
 __all__ = ["STOP_POLICY", "check_val_episodes", "choose_and_test", "stop_policy_markdown"]
 
@@ -72,20 +73,23 @@ def choose_and_test(
     ds = open_dataset(data)
     maps = out / "maps"
     val_config = config.replace(split="val", episodes=val_episodes, trace=True)
-    val = run_navigation(runs, navigator, ds, val_config, epsilon=epsilon, workers=workers,
-                         out=out / "val", maps=maps, progress=progress)  # fmt: skip
-    choices = [choose_rule(run["episodes"], run["epsilon"], k_max=config.k_max)
-               for run in val["runs"]]  # fmt: skip
-    test = run_navigation(runs, navigator, ds, config.replace(trace=True), epsilon=epsilon,
-                          workers=workers, out=out / "test", maps=maps,
-                          progress=progress)  # fmt: skip
-    rules = {run: StopRule(**choice["chosen"]) for run, choice in zip(runs, choices, strict=True)}
-    learned = [None] * len(runs)
-    if map_memory != "off":
-        live = run_navigation(runs, navigator, ds, live_config, epsilon=epsilon,
-                              workers=workers, out=out / f"memory-{map_memory}", maps=maps,
-                              stop_rules=rules, progress=progress)  # fmt: skip
-        learned = [case_rates(run["episodes"]) for run in live["runs"]]
+    with executor_session(workers=workers):  # one pool for the three navigations
+        val = run_navigation(runs, navigator, ds, val_config, epsilon=epsilon, workers=workers,
+                             out=out / "val", maps=maps, progress=progress)  # fmt: skip
+        choices = [choose_rule(run["episodes"], run["epsilon"], k_max=config.k_max)
+                   for run in val["runs"]]  # fmt: skip
+        test = run_navigation(runs, navigator, ds, config.replace(trace=True), epsilon=epsilon,
+                              workers=workers, out=out / "test", maps=maps,
+                              progress=progress)  # fmt: skip
+        rules = {
+            run: StopRule(**choice["chosen"]) for run, choice in zip(runs, choices, strict=True)
+        }
+        learned = [None] * len(runs)
+        if map_memory != "off":
+            live = run_navigation(runs, navigator, ds, live_config, epsilon=epsilon,
+                                  workers=workers, out=out / f"memory-{map_memory}", maps=maps,
+                                  stop_rules=rules, progress=progress)  # fmt: skip
+            learned = [case_rates(run["episodes"]) for run in live["runs"]]
     entries = []
     for run, choice, rule, memory in zip(test["runs"], choices, rules.values(), learned,
                                          strict=True):  # fmt: skip

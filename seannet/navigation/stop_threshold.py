@@ -16,6 +16,7 @@ from seannet.navigation.benchmark import run_labels, run_navigation
 from seannet.navigation.config import NavigationTestConfig
 from seannet.navigation.episodes import CASES
 from seannet.navigation.localizer import run_epsilon
+from sgdata.pipeline.executors import executor_session
 
 __all__ = [
     "EPSILON_OFFSETS",
@@ -85,26 +86,29 @@ def choose_epsilon(
         )
     data = open_dataset(data)  # every threshold's test shares one opening
     say = progress or (lambda _: None)
-    rows = []
-    for run, label in zip(runs, run_labels(runs), strict=True):
-        found = run_epsilon(run)
-        if found is None:
-            raise NavigationError(f"{run}: no evaluated epsilon; run `seannet eval` on val first")
-        base, source = found
-        grid = []
-        for offset in offsets:
-            epsilon = round(base + offset, 4)
-            results = run_navigation(
-                [run], navigator, data, config, epsilon=epsilon, workers=workers,
-                out=out / label / f"{epsilon:.4f}", maps=out / "maps" / label,
+    with executor_session(workers=workers):  # one pool for every threshold's navigation
+        rows = []
+        for run, label in zip(runs, run_labels(runs), strict=True):
+            found = run_epsilon(run)
+            if found is None:
+                raise NavigationError(
+                    f"{run}: no evaluated epsilon; run `seannet eval` on val first"
+                )
+            base, source = found
+            grid = []
+            for offset in offsets:
+                epsilon = round(base + offset, 4)
+                results = run_navigation(
+                    [run], navigator, data, config, epsilon=epsilon, workers=workers,
+                    out=out / label / f"{epsilon:.4f}", maps=out / "maps" / label,
+                )  # fmt: skip
+                success = success_by_case(results["runs"][0]["episodes"])
+                grid.append({"epsilon": epsilon, "offset": offset, "success": success})
+                say(f"{label} epsilon {epsilon:.3f}: success {success}")
+            rows.append(
+                {"run": str(run), "label": label, "eval_epsilon": base, "eval_source": source,
+                 "grid": grid, "chosen": best_epsilon(grid)}
             )  # fmt: skip
-            success = success_by_case(results["runs"][0]["episodes"])
-            grid.append({"epsilon": epsilon, "offset": offset, "success": success})
-            say(f"{label} epsilon {epsilon:.3f}: success {success}")
-        rows.append(
-            {"run": str(run), "label": label, "eval_epsilon": base, "eval_source": source,
-             "grid": grid, "chosen": best_epsilon(grid)}
-        )  # fmt: skip
     return {
         "split": config.split,
         "episodes_per_case_and_room": config.episodes,

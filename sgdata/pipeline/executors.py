@@ -34,6 +34,8 @@ from collections.abc import Callable, Iterable, Iterator
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
+from contextvars import ContextVar
+from dataclasses import dataclass
 from multiprocessing.process import BaseProcess
 from pathlib import Path
 from typing import Any
@@ -88,15 +90,53 @@ def run_tasks(
 
 
 @contextmanager
-def executor_session(executor: str, *, workers: int, address: str | None) -> Iterator[None]:
-    """Keep the executor's engine up across several :func:`run_tasks` calls (a local Ray
-    instance starts once per generation, not once per phase)."""
+def executor_session(
+    executor: str = "local", *, workers: int, address: str | None = None
+) -> Iterator[None]:
+    """Keep the executor's engine up across several :func:`run_tasks` calls: a local Ray
+    instance, or the local pool, starts once per command, not once per phase. A spawned
+    worker takes seconds to import torch and the renderer; a command of many phases (the
+    stop policy's four navigations, each with maps and episodes) paid that 24 times.
+    Sessions nest: an inner one with the same workers keeps the outer one's pool."""
     _check(executor, address)
-    if executor != "ray":
+    if executor == "ray":
+        with _ray_executor().ray_session(address, workers, WORKER_ENV):
+            yield
+        return
+    outer = _LOCAL_SESSION.get()
+    if outer is not None and outer.workers == workers:
         yield
         return
-    with _ray_executor().ray_session(address, workers, WORKER_ENV):
-        yield
+    with tempfile.TemporaryDirectory(prefix="sgdata-tasks-") as notes:
+        session = _LocalSession(workers, Path(notes))
+        token = _LOCAL_SESSION.set(session)
+        try:
+            yield
+        finally:
+            _LOCAL_SESSION.reset(token)
+            session.close()
+
+
+@dataclass
+class _LocalSession:
+    """A local pool kept across :func:`run_tasks` calls; started by the first task."""
+
+    workers: int
+    notes: Path
+    pool: ProcessPoolExecutor | None = None
+
+    def started_pool(self) -> ProcessPoolExecutor:
+        if self.pool is None or getattr(self.pool, "_broken", False):  # a dead worker broke it
+            self.close()
+            self.pool = _pool(self.workers)
+        return self.pool
+
+    def close(self) -> None:
+        if self.pool is not None:
+            self.pool.shutdown(cancel_futures=True)
+
+
+_LOCAL_SESSION: ContextVar[_LocalSession | None] = ContextVar("sgdata_local_pool", default=None)
 
 
 def _ray_executor():  # noqa: ANN202
@@ -120,35 +160,49 @@ def _check(executor: str, address: str | None) -> None:
 
 
 def _run_local(fn: Callable[..., dict], jobs: list[tuple], *, workers: int) -> Iterator[dict]:
-    context = multiprocessing.get_context("spawn")
+    session = _LOCAL_SESSION.get()
+    if session is not None and session.workers == workers:
+        yield from _drain(session.started_pool(), fn, jobs, session.notes)
+        return
     with (
         tempfile.TemporaryDirectory(prefix="sgdata-tasks-") as notes,
-        ProcessPoolExecutor(
-            max_workers=min(workers, len(jobs)),
-            mp_context=context,
-            initializer=_init_worker,
-            initargs=(os.getpid(),),
-        ) as pool,
+        _pool(min(workers, len(jobs))) as pool,
     ):
-        pending: set[Future[Any]] = {
-            pool.submit(_noted, Path(notes), task_name(payload, k), fn, *payload)
-            for k, payload in enumerate(jobs)
-        }
-        # every worker has started once all is submitted; kept to read a dead one's exit code
-        started: dict[int, BaseProcess] = dict(getattr(pool, "_processes", None) or {})
-        try:
-            while pending:
-                finished, pending = wait(pending, return_when=FIRST_COMPLETED)
-                for future in finished:
-                    try:
-                        result = future.result()
-                    except BrokenProcessPool:
-                        raise WorkerError(_death(started, Path(notes))) from None
-                    yield result
-        except BaseException:
-            for future in pending:
-                future.cancel()
-            raise
+        yield from _drain(pool, fn, jobs, Path(notes))
+
+
+def _pool(workers: int) -> ProcessPoolExecutor:
+    return ProcessPoolExecutor(
+        max_workers=workers,
+        mp_context=multiprocessing.get_context("spawn"),
+        initializer=_init_worker,
+        initargs=(os.getpid(),),
+    )
+
+
+def _drain(
+    pool: ProcessPoolExecutor, fn: Callable[..., dict], jobs: list[tuple], notes: Path
+) -> Iterator[dict]:
+    """Submit every job to ``pool``; yield results as they finish."""
+    pending: set[Future[Any]] = {
+        pool.submit(_noted, notes, task_name(payload, k), fn, *payload)
+        for k, payload in enumerate(jobs)
+    }
+    # every worker has started once all is submitted; kept to read a dead one's exit code
+    started: dict[int, BaseProcess] = dict(getattr(pool, "_processes", None) or {})
+    try:
+        while pending:
+            finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+            for future in finished:
+                try:
+                    result = future.result()
+                except BrokenProcessPool:
+                    raise WorkerError(_death(started, notes)) from None
+                yield result
+    except BaseException:
+        for future in pending:
+            future.cancel()
+        raise
 
 
 def task_name(payload: tuple, index: int) -> str:
