@@ -35,7 +35,7 @@ def run_cli(prog: str, *args: object, columns: int = 120) -> Done:
         raise ValueError(f"prog is {prog!r}: expected 'sgdata' or 'seannet'")
     out, err = io.StringIO(), io.StringIO()
     argv, sys.argv = sys.argv, [prog, *map(str, args)]
-    columns = os.environ.get("COLUMNS")
+    saved = os.environ.get("COLUMNS")
     os.environ["COLUMNS"] = str(columns)
     code = 0
     try:
@@ -49,8 +49,8 @@ def run_cli(prog: str, *args: object, columns: int = 120) -> Done:
             code = exc.code or 0
     finally:
         sys.argv = argv
-        if columns is None:
+        if saved is None:
             os.environ.pop("COLUMNS")
         else:
-            os.environ["COLUMNS"] = columns
+            os.environ["COLUMNS"] = saved
     return Done(code, out.getvalue(), err.getvalue())

@@ -12,7 +12,7 @@ import pytest
 
 from sgdata.errors import ConfigError
 from sgdata.pipeline.config import load_config
-from sgdata.pipeline.executors import die_with_parent, run_tasks
+from sgdata.pipeline.executors import die_with_parent, executor_session, run_tasks
 from sgdata.pipeline.generate import generate_dataset
 from sgdata.pipeline.ledger import LEDGER
 
@@ -71,3 +71,18 @@ def test_a_worker_whose_parent_is_gone_exits() -> None:
     done = subprocess.run([sys.executable, "-c", code], timeout=60)
     assert done.returncode == 1  # its parent is not pid 1
     die_with_parent(os.getppid())  # our real parent: nothing happens
+
+
+def test_a_session_keeps_one_local_pool_across_calls_and_nested_sessions() -> None:
+    """Inside a session every run_tasks call (a nested session's too) runs in the same
+    spawned worker; outside one, each call starts its own, gone when the call ends."""
+    with executor_session(workers=1):
+        first = list(run_tasks(os.getpid, [()], workers=1))
+        with executor_session(workers=1):
+            nested = list(run_tasks(os.getpid, [()], workers=1))
+        second = list(run_tasks(os.getpid, [()], workers=1))
+        other = list(run_tasks(os.getpid, [(), ()], workers=2))  # another size: its own pool
+    alone = list(run_tasks(os.getpid, [()], workers=1))
+    assert first == nested == second and os.getpid() not in first
+    assert set(other).isdisjoint(first) and alone != first
+    assert not any(Path(f"/proc/{pid}").exists() for pid in first + other + alone)
