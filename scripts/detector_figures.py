@@ -12,12 +12,12 @@ from __future__ import annotations
 
 import argparse
 import json
-import shutil
 from pathlib import Path
 
 from seannet.markdown import pct, table
 from seannet.provenance import read_provenance, stamp
 from sgdata.dataset import Dataset
+from sgdata.fileio import atomic_write_bytes
 from sgdata.markdown import replace_block
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -33,12 +33,17 @@ def record(detector: Path, cards: Path, data: Path) -> Path:
     folder = RECORDS / f"{ds.manifest.name}-{ds.manifest.recipe_fingerprint()[:16]}"
     (folder / "cards").mkdir(parents=True, exist_ok=True)
     for name in RUN_FILES:
-        shutil.copyfile(detector / name, folder / name)
+        _copy(detector / name, folder / name)
     threshold = detector / "graphs" / ds.manifest_sha256[:16] / "threshold.json"
-    shutil.copyfile(threshold, folder / "threshold.json")
+    _copy(threshold, folder / "threshold.json")
     for card in sorted(cards.glob("*/card.json")):
-        shutil.copyfile(card, folder / "cards" / f"{card.parent.name}.json")
+        _copy(card, folder / "cards" / f"{card.parent.name}.json")
     return folder
+
+
+def _copy(source: Path, target: Path) -> None:
+    """Evidence is committed: a copy cut short must not leave half a file behind."""
+    atomic_write_bytes(target, source.read_bytes())
 
 
 def _detector_rows(folder: Path) -> list[str]:
