@@ -14,6 +14,7 @@ from sgdata_cli.errors import run_app
 
 from sgdata.dataset.paths import MANIFEST
 from sgdata.dataset.tolerance import Tolerance
+from sgdata.label.box_proposer import DEFAULT_MIN_SCORE
 
 app = typer.Typer(
     rich_markup_mode=None,  # help text as written: a config's [catalog] stays
@@ -481,14 +482,30 @@ def label(
             help="Largest photo to open, in pixels (default: Pillow's decompression-bomb guard).",
         ),
     ] = None,
+    detector: Annotated[
+        Path | None,
+        typer.Option(
+            "--detector",
+            help="A detector run (seannet detector train --out RUN): its boxes pre-fill each "
+            "photo never saved, marked as proposed until accepted.",
+        ),
+    ] = None,
+    min_score: Annotated[
+        float, typer.Option("--min-score", help="The --detector's boxes of at least this score.")
+    ] = DEFAULT_MIN_SCORE,
 ) -> None:
     """Label real photos in a local web page (boxes, classes, relations), or --export them.
 
     A --classes map is remembered beside the labels: later runs and --export use it.
     """
+    from sgdata.errors import ConfigError
     from sgdata.label.photos import DEFAULT_MAX_PIXELS
 
     pixels = max_pixels or DEFAULT_MAX_PIXELS
+    if export and detector is not None:
+        raise ConfigError(
+            "--detector proposes boxes in the page; --export writes the saved labels: give one"
+        )
     if export:
         from sgdata.label.export import export_dataset
 
@@ -507,6 +524,13 @@ def label(
             console.print(
                 f"left out {len(done.never_labeled)} photo(s) never labeled: "
                 + ", ".join(done.never_labeled),
+                markup=False,
+            )
+        if done.guessed:
+            where = ", ".join(f"{name} ({n})" for name, n in done.guessed.items())
+            console.print(
+                f"left out {sum(done.guessed.values())} proposed box(es) never accepted: "
+                f"{where}; accept (Enter) or delete them in the page",
                 markup=False,
             )
         if done.pending:
@@ -528,6 +552,8 @@ def label(
         port=port,
         class_map=classes,
         max_pixels=pixels,
+        detector=detector,
+        min_score=min_score,
         on_ready=lambda url: console.print(f"labeling {photos} at {url} (Ctrl-C stops)"),
     )
 

@@ -313,6 +313,24 @@ def localizer_run(tmp_path_factory: pytest.TempPathFactory, mini_dataset: Path) 
     return shared_artefact(tmp_path_factory, "localizer_run", build)
 
 
+@pytest.fixture(scope="session")
+def detector_run(tmp_path_factory: pytest.TempPathFactory, channels_dataset: Path) -> Path:
+    """A detector run (FCOS on Lite0, 96 px, two epochs) trained on the channels dataset's
+    COCO export by ``seannet detector train``: the detection tests copy it (their evals
+    write into it), the labeling tool proposes its boxes."""
+
+    def build(run: Path) -> None:
+        from tests.cli_runner import run_cli
+
+        done = run_cli(
+            "seannet", "detector", "train", "--data", channels_dataset, "--out", run,
+            "--epochs", "2", "--size", "96", "--val-views", "0",
+        )  # fmt: skip
+        assert done.returncode == 0, done.stderr
+
+    return shared_artefact(tmp_path_factory, "detector_run", build)
+
+
 def tiny_navigation() -> dict:
     """What the tiny navigation run used: the kill-and-resume test runs it again with these."""
     from seannet.navigation.config import NavigationTestConfig

@@ -39,6 +39,8 @@ __all__ = [
 ]
 
 DETECTOR, DETECTOR_JSON, COCO = "detector.pt", "detector.json", "coco"
+# the labeling tool's box proposer of a run (seannet.detection.proposer; sgdata label --detector)
+PROPOSER = "seannet.detection.proposer:open_proposer"
 # progress(phase, done, total, metrics): "train" counts steps, "val" views
 Progress = Callable[[str, int, int, dict[str, float]], None]
 
@@ -107,6 +109,8 @@ def train_detector(
         "config": config.to_dict(),
         "dataset": dataset_identity(ds),
         "classes": list(ds.class_names),
+        # what opens this run as the labeling tool's box proposer (sgdata label --detector)
+        "proposer": PROPOSER,
         "epochs": [],
         "best_epoch": None,
         "stopped": "epochs",

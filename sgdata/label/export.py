@@ -46,6 +46,7 @@ class ExportSummary:
     unlabeled: list[str] = field(default_factory=list)  # photos without a room id (left out)
     never_labeled: list[str] = field(default_factory=list)  # photos with no labels saved
     pending: dict[str, int] = field(default_factory=dict)  # photo -> proposals never decided
+    guessed: dict[str, int] = field(default_factory=dict)  # photo -> proposed boxes left out
     dropped: int = 0  # objects beyond their class's slot run
     notes: list[str] = field(default_factory=list)
 
@@ -79,7 +80,7 @@ def export_dataset(
         DatasetError: a label names an unknown class, or two photos get the same id.
     """
     from sgdata.dataset.vocabulary import class_vocabulary
-    from sgdata.label.review import proposals_for, undecided
+    from sgdata.label.review import accepted_only, proposals_for, undecided
 
     if split not in SPLITS:
         raise ConfigError(f"--split {split!r}: expected one of {', '.join(SPLITS)}")
@@ -102,6 +103,10 @@ def export_dataset(
         if labels.room_id is None:
             summary.unlabeled.append(photo_name)
             continue
+        guessed = sum(o.proposed is not None for o in labels.objects)
+        if guessed:
+            summary.guessed[photo_name] = guessed
+            labels = accepted_only(labels)
         pending = len(undecided(labels, proposals_for(labels, classes, rules)))
         if pending:
             summary.pending[photo_name] = pending

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, model_serializer, model_validator
 
 from sgdata.world.room_recipes import ROOM_TYPES
 
@@ -35,6 +35,8 @@ class LabeledObject(BaseModel):
     class_name: Annotated[str, Field(max_length=100)]  # a catalog class or a mapped name; "" unset
     # [u1, v1, u2, v2] pixels, u2 and v2 exclusive
     box: Annotated[list[int], Field(min_length=4, max_length=4)]
+    # a detector's box no one has accepted yet: its score (None: drawn or accepted by a person)
+    proposed: Annotated[float, Field(ge=0, le=1)] | None = None
 
     @model_validator(mode="after")
     def _box_order(self) -> LabeledObject:
@@ -42,6 +44,14 @@ class LabeledObject(BaseModel):
         if not (0 <= u1 < u2 and 0 <= v1 < v2):
             raise ValueError(f"box {list(self.box)}: expected 0 <= u1 < u2 and 0 <= v1 < v2")
         return self
+
+    @model_serializer(mode="wrap")
+    def _proposed_only_when_so(self, handler):  # noqa: ANN001, ANN202
+        # a box a person drew is written as before: label files and the API gain no null field
+        data = handler(self)
+        if self.proposed is None:
+            data.pop("proposed", None)
+        return data
 
 
 class Decision(BaseModel):

@@ -16,11 +16,19 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
 from PIL import Image, ImageOps, UnidentifiedImageError
 
 from sgdata.errors import ConfigError
 
-__all__ = ["DEFAULT_MAX_PIXELS", "Photo", "PhotoIndex", "scan_photos", "photo_bytes"]
+__all__ = [
+    "DEFAULT_MAX_PIXELS",
+    "Photo",
+    "PhotoIndex",
+    "photo_bytes",
+    "scan_photos",
+    "shown_pixels",
+]
 
 # Pillow format -> the dataset's image_format.
 FORMATS = {"PNG": "png", "JPEG": "jpeg"}
@@ -176,3 +184,10 @@ def photo_bytes(photo: Photo) -> tuple[bytes, str]:
     buffer = io.BytesIO()
     shown.save(buffer, format="PNG", optimize=False, compress_level=6)
     return buffer.getvalue(), "png"
+
+
+def shown_pixels(photo: Photo) -> np.ndarray:
+    """The photo's pixels as the page shows them: (height, width, 3) uint8 RGB, the EXIF
+    orientation applied (what a detector proposing boxes on it must see)."""
+    with _own_size_check(), Image.open(photo.path) as image:
+        return np.asarray(ImageOps.exif_transpose(image).convert("RGB"))

@@ -6,7 +6,7 @@ from sgdata.label.classes import ClassNames
 from sgdata.label.models import PhotoLabels
 from sgdata.label.proposals import Proposal, ProposalRules, propose_relations
 
-__all__ = ["proposals_for", "undecided", "problems", "room_instances"]
+__all__ = ["accepted_only", "proposals_for", "undecided", "problems", "room_instances"]
 
 
 def proposals_for(labels: PhotoLabels, classes: ClassNames, rules: ProposalRules) -> list[Proposal]:
@@ -22,6 +22,22 @@ def undecided(labels: PhotoLabels, proposals: list[Proposal]) -> list[Proposal]:
     """The proposals whose pair the labeler has not decided (export stores them as disjoint)."""
     decided = {frozenset((r.src, r.dst)) for r in labels.relations}
     return [p for p in proposals if frozenset((p.src, p.dst)) not in decided]
+
+
+def accepted_only(labels: PhotoLabels) -> PhotoLabels:
+    """``labels`` without the detector's boxes no one accepted, and their relations: what an
+    export writes (a guess is not a label)."""
+    guessed = {o.id for o in labels.objects if o.proposed is not None}
+    if not guessed:
+        return labels
+    return labels.model_copy(
+        update={
+            "objects": [o for o in labels.objects if o.id not in guessed],
+            "relations": [
+                r for r in labels.relations if r.src not in guessed and r.dst not in guessed
+            ],
+        }
+    )
 
 
 def room_instances(
@@ -72,6 +88,9 @@ def problems(
                 f"box {o.id} is {o.class_name} here but {other} in {where} (same room); "
                 "one id is one object: delete and redraw it, or fix the class"
             )
+    guessed = sum(o.proposed is not None for o in labels.objects)
+    if guessed:
+        out.append(f"{guessed} proposed box(es) to accept (Enter) or delete")
     pending = len(undecided(labels, proposals_for(labels, classes, rules)))
     if pending:
         out.append(f"{pending} undecided proposal(s)")

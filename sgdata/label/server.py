@@ -8,10 +8,12 @@ Routes (all same-origin, no CDN)::
                               box count and what keeps each from export; and skipped files
     GET /api/classes          catalog classes and mapped names, for the type-ahead
     GET /api/classes/unknown  ?name=...: the message for a name that is no class (closest names)
-    GET /api/labels/<name>    a photo's labels, the relations proposed from its boxes, problems
+    GET /api/labels/<name>    a photo's labels, the relations proposed from its boxes, problems;
+                              a never-saved photo's labels are the --detector's boxes, if any
     PUT /api/labels/<name>    save (JSON, <= 1 MiB, no unknown fields, the revision last seen)
 
-The proposal rules run here (``sgdata.label.proposals``); the page shows what the API returns.
+The proposal rules run here (``sgdata.label.proposals``), and so does the detector of
+``--detector`` (``sgdata.label.box_proposer``); the page shows what the API returns.
 """
 
 from __future__ import annotations
@@ -26,9 +28,16 @@ from fastapi import FastAPI, HTTPException, Request
 from fastapi.responses import FileResponse, JSONResponse, Response
 from pydantic import ValidationError
 
+from sgdata.errors import ConfigError
+from sgdata.label.box_proposer import (
+    DEFAULT_MIN_SCORE,
+    BoxProposer,
+    ProposedBox,
+    open_proposer,
+)
 from sgdata.label.classes import ClassNames, load_class_names
-from sgdata.label.models import PhotoLabels
-from sgdata.label.photos import DEFAULT_MAX_PIXELS, Photo, scan_photos
+from sgdata.label.models import LabeledObject, PhotoLabels
+from sgdata.label.photos import DEFAULT_MAX_PIXELS, Photo, scan_photos, shown_pixels
 from sgdata.label.proposals import DEFAULT_RULES, ProposalRules
 from sgdata.label.review import problems, proposals_for, room_instances
 from sgdata.label.store import ConflictError, LabelStore
@@ -100,6 +109,8 @@ def create_app(
     max_pixels: int = DEFAULT_MAX_PIXELS,
     rules: ProposalRules = DEFAULT_RULES,
     allowed_hosts: tuple[str, ...] | None = LOOPBACK,
+    detector: Path | None = None,
+    min_score: float = DEFAULT_MIN_SCORE,
 ) -> FastAPI:
     """The labeling app for the photos in ``photos_dir``, saving under ``out_dir/labels``.
 
@@ -108,14 +119,21 @@ def create_app(
             and the export (None: the remembered one, if any).
         max_pixels: larger photos are skipped, with the reason shown in the page.
         allowed_hosts: ``Host`` header values to answer (DNS-rebinding guard); None: any.
+        detector: a detector run (``sgdata.label.box_proposer``) whose boxes of score
+            >= ``min_score`` fill each photo never saved, marked as proposed.
 
     Raises:
-        ConfigError: ``photos_dir`` is not a directory, ``out_dir`` cannot be written, or a
-            bad class map.
+        ConfigError: ``photos_dir`` is not a directory, ``out_dir`` cannot be written, a bad
+            class map, or a detector run that does not open.
     """
     store = LabelStore(out_dir)
     names = load_class_names(store.class_map(class_map))
-    session = _Session(photos_dir, store, names, rules=rules, max_pixels=max_pixels)
+    proposer = None
+    if detector is not None:
+        proposer = open_proposer(detector, min_score=min_score, known=names.all_names())
+    session = _Session(
+        photos_dir, store, names, rules=rules, max_pixels=max_pixels, proposer=proposer
+    )
     app = FastAPI(title="sgdata label", docs_url=None, redoc_url=None, openapi_url=None)
     if allowed_hosts is not None:
         app.add_middleware(_HostGuard, allowed=allowed_hosts)
@@ -135,11 +153,14 @@ class _Session:
         *,
         rules: ProposalRules,
         max_pixels: int,
+        proposer: BoxProposer | None = None,
     ) -> None:
         self.photos_dir, self.store, self.names = photos_dir, store, names
-        self.rules, self.max_pixels = rules, max_pixels
+        self.rules, self.max_pixels, self.proposer = rules, max_pixels, proposer
         self.index = scan_photos(photos_dir, max_pixels=max_pixels)  # replaced by each rescan
         self._scanning = threading.Lock()
+        # (photo name, scan stamp) -> the detector's boxes: a photo is detected once per change
+        self._detected: dict[tuple[str, tuple[int, int]], list[ProposedBox]] = {}
 
     def photo(self, name: str) -> Photo:
         """The indexed photo ``name``, or a 404."""
@@ -147,6 +168,30 @@ class _Session:
         if photo is None:
             raise HTTPException(404, "no such photo")
         return photo
+
+    def labels(self, name: str) -> PhotoLabels:
+        """The saved labels of photo ``name``; for a photo never saved, the detector's boxes
+        (if any), marked as proposed, best first, with ids no saved photo uses (an id names
+        one object of a room: carry over, not the detector, ties a box to another photo's)."""
+        labels = self.store.load(name)
+        if labels.revision or self.proposer is None:
+            return labels
+        photo = self.photo(name)
+        key = (name, photo.stamp)
+        if key not in self._detected:
+            try:
+                self._detected[key] = self.proposer(shown_pixels(photo))
+            except ConfigError as exc:  # the page shows it; labeling by hand goes on
+                raise HTTPException(500, str(exc)) from None
+        saved = self.store.labeled().values()
+        first = 1 + max((o.id for other in saved for o in other.objects), default=0)
+        objects = [
+            LabeledObject(
+                id=k, class_name=b.class_name, box=list(b.box), proposed=round(b.score, 3)
+            )
+            for k, b in enumerate(self._detected[key], start=first)
+        ]
+        return labels.model_copy(update={"objects": objects})
 
     def payload(self, name: str, labels: PhotoLabels) -> dict:
         """A photo's labels as the page edits them, with proposals and what is still missing."""
@@ -158,6 +203,9 @@ class _Session:
             "problems": problems(labels, self.names, self.rules, room),
             # ids the room's other photos use: a new box takes a fresh one
             "room_ids": sorted(room),
+            "detector": None
+            if self.proposer is None
+            else {"run": str(self.proposer.run), "min_score": self.proposer.min_score},
         }
 
     def listing(self) -> dict:
@@ -255,7 +303,7 @@ def _add_api_routes(app: FastAPI, session: _Session) -> None:
     @app.get("/api/labels/{name}")
     def get_labels(name: str) -> JSONResponse:
         session.photo(name)
-        return JSONResponse(session.payload(name, session.store.load(name)), headers=_HEADERS)
+        return JSONResponse(session.payload(name, session.labels(name)), headers=_HEADERS)
 
     @app.put("/api/labels/{name}")
     async def put_labels(name: str, request: Request) -> JSONResponse:
@@ -280,6 +328,8 @@ def serve(
     port: int = 8765,
     class_map: Path | None = None,
     max_pixels: int = DEFAULT_MAX_PIXELS,
+    detector: Path | None = None,
+    min_score: float = DEFAULT_MIN_SCORE,
     on_ready: Callable[[str], None] | None = None,
 ) -> None:
     """Run the labeling app with uvicorn until interrupted (Ctrl-C stops it cleanly).
@@ -293,7 +343,13 @@ def serve(
 
     hosts = LOOPBACK if host in LOOPBACK else None
     app = create_app(
-        photos_dir, out_dir, class_map=class_map, max_pixels=max_pixels, allowed_hosts=hosts
+        photos_dir,
+        out_dir,
+        class_map=class_map,
+        max_pixels=max_pixels,
+        allowed_hosts=hosts,
+        detector=detector,
+        min_score=min_score,
     )
     config = uvicorn.Config(app, host=host, port=port, log_level="warning", lifespan="on")
     server = uvicorn.Server(config)

@@ -54,8 +54,12 @@ SEANNET_MAY_IMPORT = (
     "sgdata.pipeline.executors",  # spawned workers that die with their parent (navigate)
 )
 LIVE_VIEWS_MAY_IMPORT = ("sgdata.render", "sgdata.usd", "sgdata.annotate", "sgdata.world.poses")
-# the detector trains on and is scored against the COCO export any other tool would read
-DETECTION_MAY_IMPORT = ("sgdata.label.coco_export",)
+# the detector trains on and is scored against the COCO export any other tool would read, and
+# proposes boxes to the labeling tool through the tool's own contract
+DETECTION_MAY_IMPORT = {
+    "seannet.detection.train": ("sgdata.label.coco_export",),
+    "seannet.detection.proposer": ("sgdata.label.box_proposer",),
+}
 HEAVY = ("pxr", "pyrender", "open3d", "trimesh", "torch", "OpenGL", "sgdata.render", "sgdata.usd")
 
 
@@ -276,8 +280,7 @@ def test_seannet_imports_only_the_sgdata_it_may() -> None:
         allowed = SEANNET_MAY_IMPORT
         if module == "seannet.data.live_views":
             allowed += LIVE_VIEWS_MAY_IMPORT
-        if module == "seannet.detection.train":
-            allowed += DETECTION_MAY_IMPORT
+        allowed += DETECTION_MAY_IMPORT.get(module, ())
         for target in _imports(path, "sgdata"):
             if not any(target == a or target.startswith(a + ".") for a in allowed):
                 wrong.append(f"{module} imports {target}")

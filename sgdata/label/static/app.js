@@ -74,7 +74,7 @@ async function openPhoto(k) {
   state.idx = k; state.selected = null; state.currentRel = null; state.undo = []; state.redo = [];
   state.conflict = false;
   const { revision, ...labels } = r.body.labels;
-  state.cur = { name: p.name, width: p.width, height: p.height, revision, labels, proposals: r.body.proposals, problems: r.body.problems, roomIds: r.body.room_ids };
+  state.cur = { name: p.name, width: p.width, height: p.height, revision, labels, proposals: r.body.proposals, problems: r.body.problems, roomIds: r.body.room_ids, detector: r.body.detector };
   const img = $("#photo");
   img.src = "/photos/" + encodeURIComponent(p.name);
   await img.decode().catch(() => {});
@@ -185,10 +185,11 @@ function render() {
   const boxes = $("#boxes"); boxes.textContent = "";
   for (const o of [...L.objects].sort((a, b) => area(b) - area(a))) {
     const [u1, v1, u2, v2] = o.box;
-    const g = el("g", { class: "box" + (o.id === state.selected ? " selected" : ""), "data-id": o.id }, boxes);
+    const guess = o.proposed != null;
+    const g = el("g", { class: "box" + (o.id === state.selected ? " selected" : "") + (guess ? " proposed" : ""), "data-id": o.id }, boxes);
     el("rect", { class: "body", x: u1, y: v1, width: u2 - u1, height: v2 - v1, "data-id": o.id }, g);
     const t = el("text", { x: u1 + 3 * s, y: v1 + 16 * s, "font-size": 14 * s, "stroke-width": 3 * s }, g);
-    t.textContent = `${o.id} ${o.class_name || "?"}`;
+    t.textContent = `${o.id} ${o.class_name || "?"}` + (guess ? ` ${o.proposed.toFixed(2)}?` : "");
     if (o.id === state.selected) {
       for (const [cx, cy, corner] of [[u1, v1, "nw"], [u2, v1, "ne"], [u1, v2, "sw"], [u2, v2, "se"]]) {
         el("rect", { class: "handle", x: cx - 5 * s, y: cy - 5 * s, width: 10 * s, height: 10 * s, "data-id": o.id, "data-corner": corner }, g);
@@ -222,8 +223,9 @@ function render() {
   const ul = $("#box-list"); ul.textContent = "";
   for (const o of L.objects) {
     const li = document.createElement("li");
-    li.dataset.id = o.id; li.className = o.id === state.selected ? "selected" : "";
-    li.textContent = `${o.id} ${o.class_name || "?"} (${o.box[2] - o.box[0]}x${o.box[3] - o.box[1]})`;
+    li.dataset.id = o.id; li.className = (o.id === state.selected ? "selected" : "") + (o.proposed != null ? " proposed" : "");
+    li.textContent = `${o.id} ${o.class_name || "?"} (${o.box[2] - o.box[0]}x${o.box[3] - o.box[1]})` +
+      (o.proposed != null ? ` · proposed ${o.proposed.toFixed(2)}` : "");
     li.onclick = () => { state.selected = o.id; render(); $("#stage").focus(); };
     ul.append(li);
   }
@@ -235,6 +237,11 @@ function render() {
   const sel = byId.get(state.selected);
   const input = $("#class-input");
   input.disabled = !sel; $("#delete").disabled = !sel;
+  $("#accept-box").disabled = !(sel && sel.proposed != null);
+  const guesses = L.objects.filter((o) => o.proposed != null).length, det = state.cur.detector;
+  $("#accept-boxes").disabled = !guesses;
+  $("#proposed-note").textContent = guesses ? `${guesses} box(es) proposed` +
+    (det ? ` by ${det.run} (score ≥ ${det.min_score})` : "") + ": Enter accepts the selected one, Del deletes it" : "";
   if (document.activeElement !== input) input.value = sel ? sel.class_name : "";
 }
 function hot(id, on) {
@@ -393,6 +400,16 @@ $("#prev").onclick = () => openPhoto(state.idx - 1);
 $("#next").onclick = () => openPhoto(state.idx + 1);
 $("#carry").onclick = carryOver;
 $("#delete").onclick = () => deleteSelected();
+$("#accept-box").onclick = () => acceptBoxes([state.selected]);
+$("#accept-boxes").onclick = () => acceptBoxes(state.cur.labels.objects.map((o) => o.id));
+// A detector's box becomes a label only when accepted; edits keep it proposed.
+function acceptBoxes(ids) {
+  const chosen = state.cur.labels.objects.filter((o) => ids.includes(o.id) && o.proposed != null).map((o) => o.id);
+  if (!chosen.length) return;
+  change((L) => { for (const o of L.objects) if (chosen.includes(o.id)) delete o.proposed; });
+  setStatus(`accepted ${chosen.length} box(es)`);
+}
+const selectedProposed = () => state.cur.labels.objects.some((o) => o.id === state.selected && o.proposed != null);
 document.querySelectorAll("#accept-all button").forEach((b) => { b.onclick = () => acceptAll(b.dataset.type); });
 function deleteSelected() {
   const id = state.selected;
@@ -428,6 +445,7 @@ document.addEventListener("keydown", (e) => {
   else if (e.key === "ArrowLeft") openPhoto(state.idx - 1);
   else if (e.key === "Delete" || e.key === "Backspace") deleteSelected();
   else if (e.key === "Tab") nextPending(e.shiftKey ? -1 : 1);
+  else if (e.key === "Enter" && selectedProposed()) acceptBoxes([state.selected]);
   else if (e.key === "Escape") { state.selected = null; state.currentRel = null; render(); }
   else if (key === "c") carryOver();
   else if (key === "n") cycleBox(e.shiftKey ? -1 : 1);

@@ -44,14 +44,15 @@ def fresh_page(chromium, viewport: tuple[int, int] = (1400, 800)) -> Iterator:  
 
 
 @contextlib.contextmanager
-def app_server(photos: Path, out: Path) -> Iterator[str]:
-    """The labeling app for ``photos`` and ``out`` served on a free loopback port by uvicorn
-    in a thread, as ``sgdata label`` serves it; yields the base URL, stops it on exit."""
+def app_server(photos: Path, out: Path, **options: object) -> Iterator[str]:
+    """The labeling app for ``photos`` and ``out`` (and ``create_app``'s ``options``) served
+    on a free loopback port by uvicorn in a thread, as ``sgdata label`` serves it; yields the
+    base URL, stops it on exit."""
     import uvicorn
 
     from sgdata.label.server import LOOPBACK, create_app
 
-    app = create_app(photos, out, allowed_hosts=LOOPBACK)
+    app = create_app(photos, out, allowed_hosts=LOOPBACK, **options)
     port = free_port()
     server = uvicorn.Server(
         uvicorn.Config(app, host="127.0.0.1", port=port, log_level="warning", lifespan="on")
@@ -78,9 +79,11 @@ def labeling_page(
     *,
     viewport: tuple[int, int] = (1400, 800),
     init: str = "",
+    **options: object,
 ) -> Iterator:
-    """A page on a fresh labeling server, loaded; ``init`` runs before the page's JS."""
-    with app_server(photos, out) as url, fresh_page(chromium, viewport) as page:
+    """A page on a fresh labeling server (``create_app``'s ``options``), loaded; ``init`` runs
+    before the page's JS."""
+    with app_server(photos, out, **options) as url, fresh_page(chromium, viewport) as page:
         page.failed = []  # URLs answered >= 400 (a missing favicon shows up here)
         page.on("response", lambda r: r.status >= 400 and page.failed.append(r.url))
         if init:
