@@ -485,6 +485,17 @@ def navigate(
             "episode) or layout (for the later episodes in the same layout too).",
         ),
     ] = "off",
+    graphs: Annotated[
+        str,
+        typer.Option(
+            help="Scene graphs of the rendered views: truth (the generator's) or detected "
+            "(--detector's boxes lifted with the rendered depth; its threshold chosen on the "
+            "dataset's val views, which need depth)."
+        ),
+    ] = "truth",
+    detector: Annotated[
+        Path | None, typer.Option(help="--graphs detected: the run of seannet detector train.")
+    ] = None,
 ) -> None:
     """The navigation test (paper Table II): success and failure rates, N / A, per localizer.
     Resumes where a killed run stopped."""
@@ -497,9 +508,11 @@ def navigate(
     config = NavigationTestConfig(
         split=split, episodes=episodes, seed=seed, spacing=spacing, replan=replan
     )
+    live = _live_graphs(graphs, detector, data)
     if stop_policy:
         _navigate_stop_policy(runs, navigator, data, config, val_episodes, workers, out,
-                              epsilon=epsilon, strips=strips, map_memory=map_memory)  # fmt: skip
+                              epsilon=epsilon, strips=strips, map_memory=map_memory,
+                              graphs=live)  # fmt: skip
         return
     if map_memory != "off":
         raise NavigationError(
@@ -508,7 +521,7 @@ def navigate(
     with console.status("navigate") as status:
         result = run_navigation(
             runs, navigator, data, config, epsilon=epsilon, workers=workers, out=out, maps=maps,
-            strips=strips, progress=status.update,
+            strips=strips, graphs=live, progress=status.update,
         )  # fmt: skip
     for rule in config.rules:
         table = Table(title=f"{rule} rule, {split} of {data} ({episodes} episodes per case, room)")
@@ -518,6 +531,23 @@ def navigate(
             table.add_row(*row)
         console.print(table)
     console.print(f"wrote {result['written']} and its .json")
+
+
+def _live_graphs(graphs: str, detector: Path | None, data: object):  # noqa: ANN202
+    """``navigate``'s graph source: None for the generator's, else the detector's
+    (:class:`seannet.detection.live_graphs.LiveGraphs`)."""
+    if graphs not in ("truth", "detected"):
+        raise typer.BadParameter(f"--graphs {graphs}: expected truth or detected")
+    if (graphs == "detected") != (detector is not None):
+        raise typer.BadParameter("--graphs detected and --detector RUN go together")
+    if detector is None:
+        return None
+    from seannet.detection.live_graphs import live_graphs
+
+    with console.status("detect val views (the threshold's choice)"):
+        chosen = live_graphs(detector, data)
+    console.print(f"detected graphs: score >= {chosen.threshold:g} (best F1 on val)")
+    return chosen
 
 
 def _navigate_stop_policy(
@@ -532,6 +562,7 @@ def _navigate_stop_policy(
     epsilon: float | None,
     strips: Path | None,
     map_memory: str,
+    graphs: object = None,
 ) -> None:
     """``seannet navigate --stop-policy``: the choice on val, the test rows, the markdown."""
     from seannet.errors import NavigationError
@@ -545,7 +576,8 @@ def _navigate_stop_policy(
     with console.status("navigate --stop-policy") as status:
         result = choose_and_test(runs, navigator, data, where, config, epsilon=epsilon,
                                  workers=workers, val_episodes=val_episodes,
-                                 map_memory=map_memory, progress=status.update)  # fmt: skip
+                                 map_memory=map_memory, graphs=graphs,
+                                 progress=status.update)  # fmt: skip
     typer.echo(Path(result["written"]).read_text())
     console.print(f"wrote {result['written']} and its .json")
 

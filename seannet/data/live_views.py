@@ -6,10 +6,14 @@ files (``<dataset>/scenes/<room>/layout_<k>.usda``) with the dataset's own camer
 annotation settings and class vocabulary (all read from ``dataset.json``), each view with the
 seed ``sgdata generate`` would give it (:func:`sgdata.seeds.view_seed`), and its image passed
 through the dataset's image format, so a view the dataset holds is rendered again as stored.
+
+A ``regraph`` hook replaces each view's scene graph with another source's: a detector's
+(:mod:`seannet.detection.live_graphs`), which reads the view's image and depth.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -34,10 +38,15 @@ from sgdata.seeds import rng_for, view_seed
 
 __all__ = [
     "LiveRooms",
+    "Regraph",
     "RenderSettings",
     "layout_boxes",
     "view_tensors",
 ]
+
+
+# (annotated view with depth, the camera) -> the view with another scene graph
+Regraph = Callable[[Any, Any], Any]
 
 
 @dataclass(frozen=True)
@@ -89,13 +98,15 @@ class LiveRooms:
 
     Args:
         data: the dataset (made by ``sgdata generate``): opened already, or its root.
+        regraph: gives each annotated view (its depth kept) another scene graph; None: the
+            generator's.
 
     Raises:
         DataError: the dataset is missing or is not a generated one.
         RenderError: EGL cannot start.
     """
 
-    def __init__(self, data: DataSource) -> None:
+    def __init__(self, data: DataSource, *, regraph: Regraph | None = None) -> None:
         from sgdata.annotate.annotator import ViewAnnotator
         from sgdata.annotate.relations import RelationRules
         from sgdata.annotate.slots import SlotTable
@@ -119,7 +130,9 @@ class LiveRooms:
             slots,
             min_visible_pixels=self.settings.min_visible_pixels,
             rules=RelationRules(containment_tolerance=self.settings.containment_tolerance),
+            keep_depth=regraph is not None,
         )
+        self.regraph = regraph
         self.room_id: str | None = None
         self.layout = -1
         self.grid: Any = None  # sgdata.world.poses.PoseGrid of the loaded layout
@@ -186,6 +199,8 @@ class LiveRooms:
         seed, x, y, theta = self._pose(i, j, heading)
         record = self.annotator.view(ViewPose(x, y, theta, i, j, heading), seed=seed)
         record.rgb = self._stored(record.rgb)
+        if self.regraph is not None:  # after storing: a detector sees the image as stored
+            record = self.regraph(record, self.renderer.camera)
         return record
 
     def image(self, i: int, j: int, heading: int) -> np.ndarray:
@@ -262,7 +277,8 @@ def view_tensors(
         np.asarray(record.obj_instance),
         classes,
         np.asarray(record.obj_slot),
-        np.asarray(record.obj_box2d, dtype=np.int16).astype(np.float32),
+        # float: the generator's integer boxes as stored, a detector's as found
+        np.asarray(record.obj_box2d, dtype=np.float32).reshape(-1, 4),
         np.asarray(record.rel_src),
         np.asarray(record.rel_dst),
         np.asarray(record.rel_type),

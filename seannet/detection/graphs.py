@@ -37,7 +37,15 @@ from sgdata.dataset.channels import decode_channel, depth_metres
 from sgdata.dataset.storage import image_bytes
 from sgdata.fileio import atomic_file, atomic_write_text
 
-__all__ = ["GRAPHS_CODE", "DetectedGraphs", "choose_threshold", "detected_graphs"]
+__all__ = [
+    "GRAPHS_CODE",
+    "DetectedGraphs",
+    "ViewDetections",
+    "choose_threshold",
+    "detected_graphs",
+    "lifted_detections",
+    "view_graph",
+]
 
 GRAPHS_CODE = 1  # bump when detections, lifting, support or slots change: the cache is remade
 THRESHOLDS = tuple(round(0.1 + 0.05 * k, 2) for k in range(17))  # 0.1 .. 0.9
@@ -58,7 +66,7 @@ _DETECTIONS = pa.schema(
 
 
 @dataclass(frozen=True)
-class _ViewDetections:
+class ViewDetections:
     """One view's detections, best first."""
 
     box2d: np.ndarray  # (n, 4) float32
@@ -150,22 +158,41 @@ def _detect_split(
                 depth = depth_metres(
                     decode_channel(image_bytes(row["depth"]), where=f"{row['obs_id']}: depth")
                 )
-                boxes = dets["boxes"].numpy()
-                lo, hi, ok = lift_boxes(
-                    depth, boxes, np.asarray(row["intrinsics"]), np.asarray(row["camera_to_world"])
+                found = lifted_detections(
+                    dets, depth, np.asarray(row["intrinsics"]), np.asarray(row["camera_to_world"])
                 )
-                for k in range(len(boxes)):
+                for k in range(len(found.score)):
                     rows["obs_id"].append(row["obs_id"])
-                    rows["box2d"].append(boxes[k].tolist())
-                    rows["label"].append(int(dets["labels"][k]))
-                    rows["score"].append(float(dets["scores"][k]))
-                    rows["box3d_min"].append(lo[k].tolist())
-                    rows["box3d_max"].append(hi[k].tolist())
-                    rows["lifted"].append(bool(ok[k]))
+                    rows["box2d"].append(found.box2d[k].tolist())
+                    rows["label"].append(int(found.class_id[k]) + 1)
+                    rows["score"].append(float(found.score[k]))
+                    rows["box3d_min"].append(found.box_min[k].tolist())
+                    rows["box3d_max"].append(found.box_max[k].tolist())
+                    rows["lifted"].append(bool(found.lifted[k]))
             done += len(chunk)
             if progress is not None:
                 progress(split, done, total)
     return pa.table(rows, schema=_DETECTIONS)
+
+
+def lifted_detections(
+    found: dict[str, torch.Tensor],
+    depth: np.ndarray,
+    intrinsics: np.ndarray,
+    camera_to_world: np.ndarray,
+) -> ViewDetections:
+    """One view's detector output (torchvision's ``boxes``, ``labels``, ``scores``) lifted to
+    3D with the view's depth (metres) and camera, in the detector's order."""
+    boxes = found["boxes"].numpy()
+    lo, hi, ok = lift_boxes(depth, boxes, intrinsics, camera_to_world)
+    return ViewDetections(
+        boxes.astype(np.float32),
+        found["labels"].numpy().astype(np.int64) - 1,
+        found["scores"].numpy(),
+        lo,
+        hi,
+        ok,
+    )
 
 
 def _cached_split(
@@ -190,7 +217,7 @@ def _cached_split(
     return table
 
 
-def _by_view(table: pa.Table) -> dict[str, _ViewDetections]:
+def _by_view(table: pa.Table) -> dict[str, ViewDetections]:
     """The cached detections grouped by view, best first within a view."""
     cols = {
         name: table.column(name).to_numpy(zero_copy_only=False)
@@ -199,14 +226,14 @@ def _by_view(table: pa.Table) -> dict[str, _ViewDetections]:
     box2d = np.asarray(table.column("box2d").combine_chunks().flatten()).reshape(-1, 4)
     lo = np.asarray(table.column("box3d_min").combine_chunks().flatten()).reshape(-1, 3)
     hi = np.asarray(table.column("box3d_max").combine_chunks().flatten()).reshape(-1, 3)
-    out: dict[str, _ViewDetections] = {}
+    out: dict[str, ViewDetections] = {}
     ids = cols["obs_id"]
     order = np.lexsort((-cols["score"], ids)) if len(ids) else np.zeros(0, np.int64)
     starts = np.flatnonzero(np.r_[True, ids[order][1:] != ids[order][:-1]]) if len(ids) else []
     ends = [*starts[1:], len(order)] if len(ids) else []
     for s, e in zip(starts, ends, strict=True):
         k = order[s:e]
-        out[str(ids[k[0]])] = _ViewDetections(
+        out[str(ids[k[0]])] = ViewDetections(
             box2d[k].astype(np.float32),
             cols["label"][k].astype(np.int64) - 1,
             cols["score"][k],
@@ -217,15 +244,15 @@ def _by_view(table: pa.Table) -> dict[str, _ViewDetections]:
     return out
 
 
-def _kept(found: _ViewDetections, threshold: float) -> np.ndarray:
+def _kept(found: ViewDetections, threshold: float) -> np.ndarray:
     """The detections a graph holds: scored at least ``threshold``, at least a pixel wide and
     high (a thinner box holds no pixel, and the box terms divide by its area)."""
     size = found.box2d[:, 2:] - found.box2d[:, :2]
     return (found.score >= threshold) & (size >= 1.0).all(axis=1)
 
 
-def _graph(
-    found: _ViewDetections, threshold: float, slot_runs: np.ndarray
+def view_graph(
+    found: ViewDetections, threshold: float, slot_runs: np.ndarray
 ) -> tuple[ObjectColumns, RelationColumns]:
     """One view's graph from its detections above ``threshold``."""
     keep = _kept(found, threshold)
@@ -258,7 +285,7 @@ def _graph(
 
 
 def choose_threshold(
-    found: dict[str, _ViewDetections], truth: dict[str, tuple[np.ndarray, np.ndarray]]
+    found: dict[str, ViewDetections], truth: dict[str, tuple[np.ndarray, np.ndarray]]
 ) -> tuple[float, dict[float, float]]:
     """The score threshold of the best F1 on ``truth`` (per view: class ids and (n, 4)
     boxes), a detection matching an unmatched true box of its class at IoU >= 0.5, best
@@ -324,7 +351,7 @@ def detected_graphs(
         raise DataError(
             f"{ds.root}: no split {missing[0]!r}; detected graphs need val and {', '.join(splits)}"
         )
-    found: dict[str, _ViewDetections] = {}
+    found: dict[str, ViewDetections] = {}
     for split in dict.fromkeys(("val", *splits)):
         found.update(_by_view(_cached_split(ds, split, detector, progress)))
     val_truth = _truth(ds, "val")
@@ -342,7 +369,7 @@ def detected_graphs(
         + "\n",
     )
     slot_runs = np.array([(c.slot_start, c.slot_count) for c in ds.manifest.classes], np.int64)
-    empty = _ViewDetections(
+    empty = ViewDetections(
         np.zeros((0, 4), np.float32),
         np.zeros(0, np.int64),
         np.zeros(0),
@@ -358,5 +385,5 @@ def detected_graphs(
                 .column("obs_id")
                 .to_pylist()
             ):
-                views[obs_id] = _graph(found.get(obs_id, empty), threshold, slot_runs)
+                views[obs_id] = view_graph(found.get(obs_id, empty), threshold, slot_runs)
     return DetectedGraphs.of(views, detector.checkpoint_sha256, threshold)

@@ -20,6 +20,10 @@ of everything they depend on; a run that was killed starts again where it stoppe
 whose key differs is run again. Wall times are the one thing that varies: they are written
 to ``navigate_<split>_times.json``, beside ``navigate_<split>.json``, which holds the same
 bytes for the same settings whatever the worker count or the interruptions.
+
+With ``graphs`` (a detector, :mod:`seannet.detection.live_graphs`), every view the maps and
+the episodes render gets the detector's scene graph instead of the generator's; a run's label
+then ends in the graphs' (``seed0@detected-1a2b3c4d-t0.5``), so its maps and parts are its own.
 """
 
 from __future__ import annotations
@@ -37,6 +41,7 @@ from PIL import Image, ImageDraw, ImageFont
 from seannet.data.datasets import dataset_identity, open_dataset
 from seannet.data.live_views import LiveRooms
 from seannet.data.opening import DataSource
+from seannet.detection.live_graphs import LiveGraphs
 from seannet.errors import NavigationError
 from seannet.methods.cards import method_label
 from seannet.navigation.config import MAP_SPACING, NavigationTestConfig
@@ -89,6 +94,7 @@ def run_navigation(
     maps: Path | None = None,
     strips: Path | None = None,
     stop_rules: dict[Path | str, StopRule] | None = None,
+    graphs: LiveGraphs | None = None,
     progress: Callable[[str], None] | None = None,
 ) -> dict[str, Any]:
     """Run the navigation test of every localizer run on the rooms of ``config.split``.
@@ -105,6 +111,8 @@ def run_navigation(
         stop_rules: beyond the paper, per run the rule its live episodes stop by instead of
             the paper's (its ending is read as the paper row's); with ``config.map_memory``
             the map learns the layout (:func:`seannet.navigation.episodes.run_episode`).
+        graphs: the detector whose scene graphs every rendered view gets; None: the
+            generator's.
 
     Writes ``navigate_<split>.json`` and ``.md`` into ``out`` (default: the navigator run),
     maps under ``maps`` (default: ``out/maps``), and under ``strips`` when given, per run,
@@ -142,12 +150,14 @@ def run_navigation(
         "navigator": str(navigator) if navigator is not None else ORACLE,
         "navigator_sha256": sha256_file(navigator / BEST)[0] if navigator is not None else ORACLE,
         "dataset": identity,
+        **({"graphs": dataclasses.asdict(graphs)} if graphs is not None else {}),
     }
-    labels = dict(zip(runs, run_labels(runs), strict=True))
+    suffix = f"@{graphs.label}" if graphs is not None else ""
+    labels = {run: label + suffix for run, label in zip(runs, run_labels(runs), strict=True)}
     named = dict(zip(runs, localizers, strict=True))
     with executor_session(workers=workers):  # one pool for the maps and the episodes
         _build_maps(
-            named, ds.root, rooms, {r: maps / labels[r] for r in runs}, config, workers, say
+            named, ds.root, rooms, {r: maps / labels[r] for r in runs}, config, graphs, workers, say
         )
         rules = stop_rules or {}
         jobs = {
@@ -188,12 +198,13 @@ def _build_maps(
     rooms: list[str],
     directories: dict[Path | str, Path],
     config: NavigationTestConfig,
+    graphs: LiveGraphs | None,
     workers: int,
     say: Callable[[str], None],
 ) -> None:
     """Build the maps of every run and room that are missing or stale (in workers)."""
     jobs = [
-        (str(run), data, room_id, directories[run] / room_id, config.spacing)
+        (str(run), data, room_id, directories[run] / room_id, config.spacing, graphs)
         for run, loc in localizers.items()
         for room_id in rooms
         if current_map(loc, room_id, directories[run] / room_id, spacing=config.spacing) is None
@@ -336,7 +347,7 @@ def run_labels(runs: list[Path | str]) -> list[str]:
 _KEY_FIELDS = (
     "split", "episodes_per_case_and_room", "seed", "k_max", "spacing", "replan", "trace",
     "navigator_sha256", "dataset", "run", "checkpoint_sha256", "epsilon", "room_id", "case",
-    "stop_rule", "map_memory",
+    "stop_rule", "map_memory", "graphs",
 )  # fmt: skip
 
 
@@ -367,12 +378,19 @@ def _one_thread() -> None:
     torch.set_num_threads(1)
 
 
-def _map_task(run: str, data: Path, room_id: str, directory: Path, spacing: int) -> dict:
+def _live_rooms(ds: Any, graphs: LiveGraphs | None) -> LiveRooms:
+    """The task's renderer, its views given the detector's graphs when ``graphs`` says so."""
+    return LiveRooms(ds, regraph=graphs.regraph(ds) if graphs is not None else None)
+
+
+def _map_task(
+    run: str, data: Path, room_id: str, directory: Path, spacing: int, graphs: LiveGraphs | None
+) -> dict:
     """Build (or reuse) one room's map by one run (in a worker)."""
     _one_thread()
     ds = open_dataset(data)  # once per task: a worker has no handle of the command's
     localizer = open_localizer(run, ds, require_epsilon=False)
-    with LiveRooms(ds) as live:
+    with _live_rooms(ds, graphs) as live:
         ensure_map(localizer, live, room_id, directory, spacing=spacing)
     return {"run": str(run), "room_id": room_id}
 
@@ -393,7 +411,8 @@ def _case_task(job: dict[str, Any], data: str, out: str) -> dict:
     learned: dict[int, np.ndarray] = {}  # map_memory "layout": the map as each layout taught it
     records = []
     drawn: set[str] = set()  # the outcome kinds drawn as strips already
-    with LiveRooms(ds) as live:
+    graphs = LiveGraphs(**job["graphs"]) if "graphs" in job else None
+    with _live_rooms(ds, graphs) as live:
         for index in range(job["episodes_per_case_and_room"]):
             rng = rng_for(episode_seed(job["seed"], room_id, case, index))
             episode = sample_episode(topo, live, case, rng, index=index)

@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from seannet.data.opening import DataSource, open_dataset
+from seannet.detection.live_graphs import LiveGraphs
 from seannet.errors import NavigationError
 from seannet.markdown import table
 from seannet.navigation.benchmark import run_navigation
@@ -49,6 +50,7 @@ def choose_and_test(
     val_episodes: int = STOP_POLICY_VAL_EPISODES,
     map_memory: str = "off",
     workers: int = 1,
+    graphs: LiveGraphs | None = None,
     progress: Callable[[str], None] | None = None,
 ) -> dict[str, Any]:
     """Choose each localizer's stop rule on val, then judge the test episodes once by it and
@@ -56,6 +58,7 @@ def choose_and_test(
     ``epsilon`` as :func:`run_navigation` takes it (None: each run's eval epsilon): the paper
     row's threshold and the centre of the grid the rule is chosen from. ``map_memory``
     (:data:`~seannet.navigation.config.MAP_MEMORY`): off, or the third row's scope.
+    ``graphs``: a detector's scene graphs for every rendered view, val and test alike.
 
     Raises:
         NavigationError: ``config`` is not of the test split, or asks for ``replan``; what
@@ -75,11 +78,12 @@ def choose_and_test(
     val_config = config.replace(split="val", episodes=val_episodes, trace=True)
     with executor_session(workers=workers):  # one pool for the three navigations
         val = run_navigation(runs, navigator, ds, val_config, epsilon=epsilon, workers=workers,
-                             out=out / "val", maps=maps, progress=progress)  # fmt: skip
+                             out=out / "val", maps=maps, graphs=graphs,
+                             progress=progress)  # fmt: skip
         choices = [choose_rule(run["episodes"], run["epsilon"], k_max=config.k_max)
                    for run in val["runs"]]  # fmt: skip
         test = run_navigation(runs, navigator, ds, config.replace(trace=True), epsilon=epsilon,
-                              workers=workers, out=out / "test", maps=maps,
+                              workers=workers, out=out / "test", maps=maps, graphs=graphs,
                               progress=progress)  # fmt: skip
         rules = {
             run: StopRule(**choice["chosen"]) for run, choice in zip(runs, choices, strict=True)
@@ -88,7 +92,8 @@ def choose_and_test(
         if map_memory != "off":
             live = run_navigation(runs, navigator, ds, live_config, epsilon=epsilon,
                                   workers=workers, out=out / f"memory-{map_memory}", maps=maps,
-                                  stop_rules=rules, progress=progress)  # fmt: skip
+                                  stop_rules=rules, graphs=graphs,
+                                  progress=progress)  # fmt: skip
             learned = [case_rates(run["episodes"]) for run in live["runs"]]
     entries = []
     for run, choice, rule, memory in zip(test["runs"], choices, rules.values(), learned,
@@ -110,6 +115,7 @@ def choose_and_test(
         "val": val_config.settings(),
         "test": config.replace(trace=True).settings(),
         "map_memory": map_memory,
+        **({"graphs": test["graphs"]} if graphs is not None else {}),
         "runs": entries,
     }
     atomic_write_text(out / STOP_POLICY, json.dumps(result, indent=1))

@@ -61,11 +61,19 @@ class CameraConfig:
         """Rows right, up, forward (world unit vectors) for heading ``theta`` (rad about +Z)."""
         return basis(theta, self.pitch_deg)
 
+    @property
+    def intrinsics(self) -> tuple[float, float, float, float]:
+        """fx, fy, cx, cy for continuous pixel coordinates: a view's ``intrinsics`` column."""
+        return self.focal, self.focal, self.width / 2.0, self.height / 2.0
+
+    def camera_to_world(self, x: float, y: float, theta: float) -> np.ndarray:
+        """4x4 camera-to-world transform with OpenCV's axes: a view's ``camera_to_world``."""
+        return camera_to_world(x, y, theta, self.eye_height, self.pitch_deg)
+
     def pose_matrix(self, x: float, y: float, theta: float) -> np.ndarray:
         """4x4 camera-to-world transform in OpenGL convention (camera looks along -Z, +Y up):
         the dataset's ``camera_to_world`` (OpenCV axes) turned to OpenGL's."""
-        cv = camera_to_world(x, y, theta, self.eye_height, self.pitch_deg)
-        return cv @ OPENGL_FROM_OPENCV
+        return self.camera_to_world(x, y, theta) @ OPENGL_FROM_OPENCV
 
     def project(self, points: np.ndarray, x: float, y: float, theta: float) -> np.ndarray:
         """World points (N, 3) -> (N, 3) of continuous pixel u, v and forward depth (m)."""
