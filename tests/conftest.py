@@ -9,6 +9,7 @@ import contextlib
 import fcntl
 import json
 import os
+import shutil
 import sys
 import time
 from collections.abc import Iterator
@@ -329,6 +330,15 @@ def detector_run(tmp_path_factory: pytest.TempPathFactory, channels_dataset: Pat
         assert done.returncode == 0, done.stderr
 
     return shared_artefact(tmp_path_factory, "detector_run", build)
+
+
+@pytest.fixture(scope="module")
+def detector_copy(tmp_path_factory: pytest.TempPathFactory, detector_run: Path) -> Path:
+    """The shared detector run copied for a module whose commands write into the run (scores,
+    the detected graphs' cache and threshold)."""
+    run = tmp_path_factory.mktemp("detector") / "run"
+    shutil.copytree(detector_run, run)
+    return run
 
 
 def tiny_navigation() -> dict:

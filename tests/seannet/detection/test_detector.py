@@ -15,11 +15,9 @@ from tests.cli_runner import run_cli
 
 
 @pytest.fixture(scope="module")
-def detector_run(tmp_path_factory: pytest.TempPathFactory, detector_run: Path) -> Path:
-    """The shared detector run, copied: evaluation writes its scores and graphs into it."""
-    run = tmp_path_factory.mktemp("detector") / "run"
-    shutil.copytree(detector_run, run)
-    return run
+def detector_run(detector_copy: Path) -> Path:
+    """This module's evaluations write into the run: its own copy."""
+    return detector_copy
 
 
 def test_a_trained_detector_records_its_curve_and_is_scored_by_pycocotools(

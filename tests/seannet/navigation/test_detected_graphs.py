@@ -5,11 +5,9 @@ maps, parts and results of such a run are its own."""
 from __future__ import annotations
 
 import json
-import shutil
 from pathlib import Path
 
 import numpy as np
-import pytest
 
 from seannet.data.live_views import LiveRooms
 from seannet.detection.graphs import detected_graphs
@@ -21,20 +19,12 @@ from sgdata.dataset import Dataset, observations_schema, read_table
 from tests.cli_runner import run_cli
 
 
-@pytest.fixture(scope="module")
-def detector(tmp_path_factory: pytest.TempPathFactory, detector_run: Path) -> Path:
-    """The shared detector run, copied: the threshold's choice caches val's detections in it."""
-    run = tmp_path_factory.mktemp("live-detector") / "run"
-    shutil.copytree(detector_run, run)
-    return run
-
-
 def test_a_rendered_view_gets_the_graph_its_stored_view_gets(
-    detector: Path, channels_dataset: Path
+    detector_copy: Path, channels_dataset: Path
 ) -> None:
     ds = Dataset.open(channels_dataset)
-    graphs = live_graphs(detector, ds)
-    stored = detected_graphs(load_detector(detector, ds), ds, ["test"])
+    graphs = live_graphs(detector_copy, ds)
+    stored = detected_graphs(load_detector(detector_copy, ds), ds, ["test"])
     assert graphs.threshold == stored.threshold and graphs.label == stored.label()
     shard = ds.observation_files("test")[0]
     columns = ["obs_id", "room_id", "layout", "grid_i", "grid_j", "heading"]
@@ -61,18 +51,18 @@ def test_a_rendered_view_gets_the_graph_its_stored_view_gets(
 
 
 def test_navigate_with_detected_graphs_keeps_its_maps_parts_and_label_apart(
-    detector: Path, channels_dataset: Path, tmp_path: Path
+    detector_copy: Path, channels_dataset: Path, tmp_path: Path
 ) -> None:
     config = NavigationTestConfig(episodes=1)
     truth = run_navigation(["boxes-overlap"], None, channels_dataset, config, epsilon=0.5,
                            out=tmp_path)  # fmt: skip
-    graphs = live_graphs(detector, channels_dataset)
+    graphs = live_graphs(detector_copy, channels_dataset)
     found = run_navigation(["boxes-overlap"], None, channels_dataset, config, epsilon=0.5,
                            out=tmp_path / "detected", maps=tmp_path / "maps",
                            graphs=graphs)  # fmt: skip
     (run,) = found["runs"]
     assert run["label"] == f"boxes-overlap@{graphs.label}"
-    assert found["graphs"] == {"run": str(detector), "detector": graphs.detector,
+    assert found["graphs"] == {"run": str(detector_copy), "detector": graphs.detector,
                                "threshold": graphs.threshold}  # fmt: skip
     assert "graphs" not in truth
     maps = sorted(p.name for p in (tmp_path / "maps").iterdir())
