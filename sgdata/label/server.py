@@ -169,11 +169,12 @@ class _Session:
             raise HTTPException(404, "no such photo")
         return photo
 
-    def labels(self, name: str) -> PhotoLabels:
+    def labels(self, name: str, saved: dict[str, PhotoLabels]) -> PhotoLabels:
         """The saved labels of photo ``name``; for a photo never saved, the detector's boxes
         (if any), marked as proposed, best first, with ids no saved photo uses (an id names
-        one object of a room: carry over, not the detector, ties a box to another photo's)."""
-        labels = self.store.load(name)
+        one object of a room: carry over, not the detector, ties a box to another photo's).
+        ``saved``: every saved photo's labels (:meth:`LabelStore.labeled`)."""
+        labels = saved.get(name, PhotoLabels())
         if labels.revision or self.proposer is None:
             return labels
         photo = self.photo(name)
@@ -183,8 +184,7 @@ class _Session:
                 self._detected[key] = self.proposer(shown_pixels(photo))
             except ConfigError as exc:  # the page shows it; labeling by hand goes on
                 raise HTTPException(500, str(exc)) from None
-        saved = self.store.labeled().values()
-        first = 1 + max((o.id for other in saved for o in other.objects), default=0)
+        first = 1 + max((o.id for other in saved.values() for o in other.objects), default=0)
         objects = [
             LabeledObject(
                 id=k, class_name=b.class_name, box=list(b.box), proposed=round(b.score, 3)
@@ -193,9 +193,13 @@ class _Session:
         ]
         return labels.model_copy(update={"objects": objects})
 
-    def payload(self, name: str, labels: PhotoLabels) -> dict:
-        """A photo's labels as the page edits them, with proposals and what is still missing."""
-        room = room_instances(self.store.labeled(), labels.room_id, name)
+    def payload(
+        self, name: str, labels: PhotoLabels, saved: dict[str, PhotoLabels] | None = None
+    ) -> dict:
+        """A photo's labels as the page edits them, with proposals and what is still missing;
+        ``saved`` as :meth:`labels` takes it (None: read now)."""
+        saved = self.store.labeled() if saved is None else saved
+        room = room_instances(saved, labels.room_id, name)
         return {
             "photo": name,
             "labels": labels.model_dump(mode="json"),
@@ -303,7 +307,9 @@ def _add_api_routes(app: FastAPI, session: _Session) -> None:
     @app.get("/api/labels/{name}")
     def get_labels(name: str) -> JSONResponse:
         session.photo(name)
-        return JSONResponse(session.payload(name, session.labels(name)), headers=_HEADERS)
+        saved = session.store.labeled()
+        labels = session.labels(name, saved)
+        return JSONResponse(session.payload(name, labels, saved), headers=_HEADERS)
 
     @app.put("/api/labels/{name}")
     async def put_labels(name: str, request: Request) -> JSONResponse:
