@@ -74,6 +74,7 @@ def test_every_pathway_has_output_and_gradient(relation: int) -> None:
     assert not torch.allclose(edge, loops)
 
 
+@pytest.mark.slow  # two SeanNets trained until the graph branch alone tells views apart
 @pytest.mark.parametrize("layout_grid", [8, 0], ids=["layout", "gcn-only"])
 def test_graph_only_seannet_learns(tmp_path: Path, mini_dataset: Path, layout_grid: int) -> None:
     """Without the image vector in the fusion, SeanNet still learns the training triplets:

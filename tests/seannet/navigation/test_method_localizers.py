@@ -106,6 +106,7 @@ def test_a_box_method_maps_and_localizes_by_its_own_similarity(
     assert result["model"] == "boxes-overlap" and result["epsilon_source"] == "--epsilon"
 
 
+@pytest.mark.slow  # a method's maps rendered and embedded, then its episodes navigated
 def test_a_method_by_name_navigates(mini_dataset: Path, navigator: Path, tmp_path: Path) -> None:
     results = run_navigation(
         ["tiny-image"], navigator, mini_dataset, ONE_EPISODE, epsilon=0.9, out=tmp_path
@@ -119,6 +120,7 @@ def test_a_method_by_name_navigates(mini_dataset: Path, navigator: Path, tmp_pat
     assert "tiny-image" in Path(results["written"]).read_text()
 
 
+@pytest.mark.slow  # a benchmark card with its navigation test and the stop rule chosen on val
 def test_benchmark_with_a_navigator_puts_the_rates_in_the_card(
     mini_dataset: Path, navigator: Path, tmp_path: Path
 ) -> None:

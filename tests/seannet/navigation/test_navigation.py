@@ -121,6 +121,7 @@ def _without_times(results: dict) -> list:
     ]
 
 
+@pytest.mark.slow  # navigate killed (kill -9) in a fresh interpreter, then resumed to the end
 def test_navigate_end_to_end_writes_table_two(
     navigation_run: SimpleNamespace, localizer_run: Path, mini_dataset: Path, tmp_path: Path, procs
 ) -> None:

@@ -129,6 +129,7 @@ def test_resume_with_another_config_is_refused(tmp_path: Path, mini_config_file:
         generate_dataset(load_config(mini_config_file), root, resume=True)
 
 
+@pytest.mark.slow  # generate killed mid-run with each executor, then resumed to the same bytes
 @pytest.mark.parametrize(
     "executor",
     # ray: a local Ray instance started, killed with the run and started again for the resume;

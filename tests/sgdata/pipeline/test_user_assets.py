@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pyarrow.parquet as pq
+import pytest
 from PIL import Image
 
 from sgdata.pipeline.config import load_config
@@ -74,6 +75,7 @@ def digest_tree(root: Path) -> dict[str, str]:
     }
 
 
+@pytest.mark.slow  # sgdata generate of rooms holding mesh-file classes, in a subprocess
 def test_generate_with_mesh_classes_end_to_end(tmp_path: Path) -> None:
     project = tmp_path / "project"
     write_demo_assets(project)
