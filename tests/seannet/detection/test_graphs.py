@@ -8,10 +8,10 @@ import pytest
 
 
 def _view(scores, classes, boxes2d, lo, hi, lifted=None):  # noqa: ANN001, ANN202
-    from seannet.detection.graphs import _ViewDetections
+    from seannet.detection.graphs import ViewDetections
 
     n = len(scores)
-    return _ViewDetections(
+    return ViewDetections(
         np.asarray(boxes2d, np.float32).reshape(n, 4),
         np.asarray(classes, np.int64),
         np.asarray(scores, float),
@@ -25,7 +25,7 @@ SLOT_RUNS = np.array([[0, 2], [2, 1], [3, 4]], np.int64)  # class 0: 2 slots, 1:
 
 
 def test_detections_fill_a_class_run_best_first_and_drop_past_its_end() -> None:
-    from seannet.detection.graphs import _graph
+    from seannet.detection.graphs import view_graph
 
     found = _view(
         [0.9, 0.8, 0.7, 0.6, 0.2],
@@ -34,7 +34,7 @@ def test_detections_fill_a_class_run_best_first_and_drop_past_its_end() -> None:
         [[0, 0, 0], [5, 5, 0], [9, 9, 0], [12, 12, 0], [20, 20, 0]],
         [[1, 1, 1], [6, 6, 1], [10, 10, 1], [13, 13, 1], [21, 21, 1]],
     )
-    (instance, class_id, slot, box), _ = _graph(found, 0.5, SLOT_RUNS)
+    (instance, class_id, slot, box), _ = view_graph(found, 0.5, SLOT_RUNS)
     # class 1 has one slot: its second detection (0.7) is dropped; 0.2 is under the threshold
     assert class_id.tolist() == [1, 0, 0]
     assert slot.tolist() == [2, 0, 1]
@@ -43,7 +43,7 @@ def test_detections_fill_a_class_run_best_first_and_drop_past_its_end() -> None:
 
 
 def test_relations_follow_the_generator_rules_on_the_lifted_boxes() -> None:
-    from seannet.detection.graphs import _graph
+    from seannet.detection.graphs import view_graph
     from sgdata.annotate.relations import RelationType
 
     # a table, a mug standing on it, a bowl far away, a cup whose depth was not seen
@@ -55,7 +55,7 @@ def test_relations_follow_the_generator_rules_on_the_lifted_boxes() -> None:
         [[1, 1, 0.75], [0.5, 0.5, 0.86], [5.2, 5.2, 0.2], [0, 0, 0]],
         lifted=[True, True, True, False],
     )
-    (instance, _, _, _), (src, dst, kind) = _graph(found, 0.5, SLOT_RUNS)
+    (instance, _, _, _), (src, dst, kind) = view_graph(found, 0.5, SLOT_RUNS)
     edges = {
         (int(s), int(d)): RelationType(int(k)).name for s, d, k in zip(src, dst, kind, strict=True)
     }
@@ -67,12 +67,12 @@ def test_relations_follow_the_generator_rules_on_the_lifted_boxes() -> None:
 
 
 def test_a_box_under_a_pixel_wide_is_left_out() -> None:
-    from seannet.detection.graphs import _graph
+    from seannet.detection.graphs import view_graph
 
     found = _view(
         [0.9, 0.8], [0, 0], [[5, 5, 5.5, 20], [0, 0, 10, 10]], [[0] * 3] * 2, [[1] * 3] * 2
     )
-    (instance, _, _, box), _ = _graph(found, 0.5, SLOT_RUNS)
+    (instance, _, _, box), _ = view_graph(found, 0.5, SLOT_RUNS)
     assert box.tolist() == [[0, 0, 10, 10]]
 
 
