@@ -1,9 +1,12 @@
 """The figures of docs/detector.md from committed evidence, never from a run folder a later
 session will not have.
 
-python scripts/detector_figures.py record --detector RUN --cards CARDS --data DATA
+python scripts/detector_figures.py record --detector RUN --cards CARDS --data DATA \
+        [--navigation OUT ...]
     copies the small JSON files of a detector run (curve, test scores, the val threshold
-    curve, provenance) and of its benchmark cards into results/detector/<name>-<recipe>/
+    curve, provenance), of its benchmark cards and of navigation tests run with
+    ``--stop-policy`` (their stop_policy.json, true or detected graphs) into
+    results/detector/<name>-<recipe>/
 python scripts/detector_figures.py doc
     writes docs/detector.md's figures block from those files alone
 """
@@ -15,6 +18,7 @@ import json
 from pathlib import Path
 
 from seannet.markdown import pct, table
+from seannet.navigation.stop_policy import STOP_POLICY
 from seannet.provenance import read_provenance, stamp
 from sgdata.dataset import Dataset
 from sgdata.fileio import atomic_write_bytes
@@ -25,13 +29,18 @@ RECORDS = ROOT / "results" / "detector"
 DOC = ROOT / "docs" / "detector.md"
 BEGIN, END = "<!-- detector-figures -->", "<!-- /detector-figures -->"
 RUN_FILES = ("detector.json", "eval_test.json", "provenance.jsonl")
+CASES = ("N", "A")
 
 
-def record(detector: Path, cards: Path, data: Path) -> Path:
+def record(detector: Path, cards: Path, data: Path, navigation: tuple[Path, ...] = ()) -> Path:
     """Copy the evidence into the dataset's folder of :data:`RECORDS`; returns it."""
     ds = Dataset.open(data)
     folder = RECORDS / f"{ds.manifest.name}-{ds.manifest.recipe_fingerprint()[:16]}"
     (folder / "cards").mkdir(parents=True, exist_ok=True)
+    for out in navigation:
+        policy = json.loads((out / STOP_POLICY).read_text())
+        graphs = "detected" if "graphs" in policy else "truth"
+        _copy(out / STOP_POLICY, folder / "navigation" / f"{graphs}.json")
     for name in RUN_FILES:
         _copy(detector / name, folder / name)
     threshold = detector / "graphs" / ds.manifest_sha256[:16] / "threshold.json"
@@ -114,6 +123,52 @@ def _localizer_rows(folder: Path) -> list[str]:
     ]
 
 
+def _navigation_rows(folder: Path) -> list[str]:
+    """True against detected graphs in the navigation test, when both were recorded."""
+    found = {p.stem: json.loads(p.read_text()) for p in (folder / "navigation").glob("*.json")}
+    if not found:
+        return []
+    rows = []
+    for graphs in ("truth", "detected"):
+        if graphs not in found:
+            continue
+        (run,) = found[graphs]["runs"]
+        for rule in ("paper", "chosen"):
+            rates = run["test"][rule]
+            chosen = f"chosen on val ({run['choice']['label']})"
+            name = "paper (S > ε)" if rule == "paper" else chosen
+            rows.append((
+                f"`{run['model']}`", graphs, name,
+                *(_rate(rates[case]["success"]) for case in CASES),
+                *(_rate(rates[case]["localization"]) for case in CASES),
+            ))  # fmt: skip
+    any_run = next(iter(found.values()))
+    episodes = any_run["test"]["episodes_per_case_and_room"]
+    return [
+        f"**Navigation** on the test rooms ({episodes} episodes per case and room, oracle "
+        f"navigator: every failure is the localizer's or the path's), success and localization "
+        "failures (%, 95 % interval clustered by room), one seed:",
+        "",
+        *table(
+            (
+                "localizer",
+                "graphs",
+                "stop rule",
+                "N success",
+                "A success",
+                "N localization",
+                "A localization",
+            ),
+            rows,
+            right=range(3, 7),
+        ),  # fmt: skip
+    ]
+
+
+def _rate(cell: dict) -> str:
+    return f"{cell['percent']:.1f} [{cell['low']:.0f}, {cell['high']:.0f}]"
+
+
 def doc() -> str:
     """The figures block from every dataset folder of :data:`RECORDS`."""
     parts = []
@@ -132,6 +187,8 @@ def doc() -> str:
             "",
             *_localizer_rows(folder),
             "",
+            *_navigation_rows(folder),
+            "",
         ]
     return "\n".join(parts).rstrip()
 
@@ -143,10 +200,11 @@ def main() -> None:
     rec.add_argument("--detector", type=Path, required=True)
     rec.add_argument("--cards", type=Path, required=True)
     rec.add_argument("--data", type=Path, required=True)
+    rec.add_argument("--navigation", type=Path, nargs="*", default=[])
     sub.add_parser("doc")
     args = parser.parse_args()
     if args.command == "record":
-        print(record(args.detector, args.cards, args.data))
+        print(record(args.detector, args.cards, args.data, tuple(args.navigation)))
     else:
         DOC.write_text(replace_block(DOC.read_text(), BEGIN, END, doc()))
         print(f"wrote {DOC}")

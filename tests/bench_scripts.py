@@ -1,5 +1,5 @@
-"""Loading a script of bench/ as a module: the one way tests of bench scripts (tests/bench/)
-load them, for their tables and verbs."""
+"""Loading a script of bench/ or scripts/ as a module: the one way tests load them, for their
+tables and verbs."""
 
 from __future__ import annotations
 
@@ -9,11 +9,21 @@ from types import ModuleType
 
 ROOT = Path(__file__).resolve().parents[1]
 BENCH = ROOT / "bench"
+SCRIPTS = ROOT / "scripts"
 
 
 def load_bench(name: str) -> ModuleType:
     """``bench/<name>.py`` as a fresh module named ``bench_<name>``."""
-    spec = importlib.util.spec_from_file_location(f"bench_{name}", BENCH / f"{name}.py")
+    return _load(f"bench_{name}", BENCH / f"{name}.py")
+
+
+def load_script(name: str) -> ModuleType:
+    """``scripts/<name>.py`` as a fresh module named ``script_<name>``."""
+    return _load(f"script_{name}", SCRIPTS / f"{name}.py")
+
+
+def _load(module_name: str, path: Path) -> ModuleType:
+    spec = importlib.util.spec_from_file_location(module_name, path)
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)

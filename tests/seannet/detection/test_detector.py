@@ -4,13 +4,13 @@ by pycocotools, its graphs fed to a localizer's evaluation in place of the gener
 from __future__ import annotations
 
 import hashlib
-import importlib.util
 import json
 import shutil
 from pathlib import Path
 
 import pytest
 
+from tests.bench_scripts import load_script
 from tests.cli_runner import run_cli
 
 
@@ -115,7 +115,7 @@ def test_the_benchmark_sweep_gains_a_detected_graphs_row(
     # the doc's figures come from evidence copied out of the runs, not from the runs
     scored = run_cli("seannet", "detector", "eval", detector_run, "--data", channels_dataset)
     assert scored.returncode == 0, scored.stderr
-    figures = _figures_script()
+    figures = load_script("detector_figures")
     figures.RECORDS = tmp_path / "records"
     folder = figures.record(detector_run, tmp_path / "cards", channels_dataset)
     shutil.rmtree(tmp_path / "cards")
@@ -124,12 +124,3 @@ def test_the_benchmark_sweep_gains_a_detected_graphs_row(
     assert "*Made by " in text and "manifest sha256" in text  # the stamp of the commands
     accuracy = card["summary"]["accuracy"]["mean"]
     assert f"| `boxes-overlap` | {100 * accuracy:.1f} |" in text
-
-
-def _figures_script():  # noqa: ANN202 - a script, loaded from its file
-    spec = importlib.util.spec_from_file_location(
-        "detector_figures", Path(__file__).parents[3] / "scripts" / "detector_figures.py"
-    )
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module

@@ -5,6 +5,7 @@ learns its layout, and `seannet navigate --stop-policy` choosing on val only."""
 from __future__ import annotations
 
 import json
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -23,6 +24,7 @@ from seannet.navigation.stopping import StopRule, candidates, choose_rule, judge
 from seannet.seeds import episode_seed
 from sgdata.seeds import rng_for
 
+from ...bench_scripts import load_script
 from ...cli_runner import run_cli
 
 EPS = 0.9
@@ -144,6 +146,29 @@ def test_the_stop_policy_is_chosen_on_val_episodes_only(
     assert a["test"]["memory"]["A"]["total"] == 2  # the map that learns its layout, live
     written = (stop_policy_run / "stop_policy.md").read_text()
     assert f"**{a['choice']['label']}**" in written and "## Test (read once)" in written
+
+
+def test_the_detector_page_shows_a_recorded_stop_policy_run(
+    stop_policy_run: Path, tmp_path: Path
+) -> None:
+    # docs/detector.md's navigation rows come from the stop_policy.json recorded, not the run
+    figures = load_script("detector_figures")
+    folder = tmp_path / "sgdata-mini"
+    (folder / "navigation").mkdir(parents=True)
+    shutil.copy(stop_policy_run / "stop_policy.json", folder / "navigation" / "truth.json")
+    (a,) = json.loads((stop_policy_run / "stop_policy.json").read_text())["runs"]
+    rows = figures._navigation_rows(folder)
+    assert "2 episodes per case and room" in rows[0]
+    for rule, name in (
+        ("paper", "paper (S > ε)"),
+        ("chosen", f"chosen on val ({a['choice']['label']})"),
+    ):
+        (row,) = [r for r in rows if name in r]
+        cells = [c.strip() for c in row.strip("|").split("|")]
+        assert cells[1] == "truth"
+        success = a["test"][rule]["A"]["success"]
+        assert cells[4] == f"{success['percent']:.1f} [{success['low']:.0f}, {success['high']:.0f}]"
+    assert figures._navigation_rows(tmp_path / "nothing recorded") == []
 
 
 @pytest.mark.parametrize("rule", [StopRule("local", 0.5, 0.02), StopRule("map", 0.3, 0.05, 2)])
