@@ -367,4 +367,16 @@ def test_a_navigation_unit_records_both_rules_and_the_doc_shows_them(
     cell = f"{success['percent']:.1f} [{success['low']:.0f}, {success['high']:.0f}]"
     assert "| `tiny-image` | 1 | " in section and cell in section.split("\n## ")[0]
     assert got["stop_rule"]["label"] in section
+    # where the failed episodes ended, and what holds the A aim back
+    missed = got["rates"]["chosen"]["A"]["localization"]
+    row = next(
+        line for line in section.splitlines() if line.startswith("| `tiny-image` | chosen |")
+    )
+    assert (
+        row.split(" | ")[3]
+        == f"{missed['percent']:.1f} [{missed['low']:.0f}, {missed['high']:.0f}]"
+    )
+    hit = got["rates"]["chosen"]["A"]["collision"]["percent"]
+    assert f"would succeed in at most {100 - hit:.1f} % of A episodes" in section
+    assert "Collisions under the paper's rule, the worst localizer: N " in section
     assert "Navigation with each network as localizer" not in (docs / "results.md").read_text()
