@@ -602,17 +602,32 @@ def leaderboard_doc(r: Records) -> str:
     for row in r.design.rows:
         runs = r.runs(row.method)
         if runs:
+            summary = summarize(runs)
+            if found := r.navigation(row.method):
+                summary["navigation"] = _navigation_summary(found)
             cards.append({"method": row.method, "trained": runs[0]["trained"],
-                          "summary": summarize(runs)})  # fmt: skip
+                          "summary": summary})  # fmt: skip
     out = header(
         r,
         "Leaderboard",
         "Every method of the protocol under the benchmark's measures (`seannet benchmark`), "
-        "best test accuracy first; a method on fewer seeds than asked says so in results.md.",
+        "best test accuracy first; a method on fewer seeds than asked says so in results.md. "
+        "Navigation: the seeds' mean success under the paper's rule and the chosen stop rule, "
+        "for the methods the protocol navigates with (intervals in results.md).",
     )
     if not cards:
         return "\n".join([*out, "No method measured yet.", ""])
     return "\n".join([*out, *leaderboard_rows(cards, timing=False), ""])
+
+
+def _navigation_summary(found: list[dict[str, Any]]) -> dict[str, Any]:
+    """A card's navigation summary (the leaderboard's cell) from a method's seeds: per rule
+    and case, their mean success."""
+    return {"rates": {
+        rule: {case: {"success": {"percent": _seeds_rate(found, rule, case, "success")[0]}}
+               for case in ("N", "A")}
+        for rule in RULES
+    }}  # fmt: skip
 
 
 def write_docs(r: Records, out: Path) -> list[Path]:

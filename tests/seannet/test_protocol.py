@@ -379,4 +379,9 @@ def test_a_navigation_unit_records_both_rules_and_the_doc_shows_them(
     hit = got["rates"]["chosen"]["A"]["collision"]["percent"]
     assert f"would succeed in at most {100 - hit:.1f} % of A episodes" in section
     assert "Collisions under the paper's rule, the worst localizer: N " in section
+    # the leaderboard's navigation cell: paper rule, then the chosen one
+    paper, chosen = (got["rates"][rule] for rule in ("paper", "chosen"))
+    cell = (f"{paper['N']['success']['percent']:.1f} / {paper['A']['success']['percent']:.1f}"
+            f" · chosen {chosen['N']['success']['percent']:.1f}")  # fmt: skip
+    assert cell in (docs / "leaderboard.md").read_text()
     assert "Navigation with each network as localizer" not in (docs / "results.md").read_text()
