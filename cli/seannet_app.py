@@ -814,6 +814,52 @@ def detector_eval(
     console.print(table)
 
 
+@detector_app.command(name="graphs")
+def detector_graphs(
+    run: Annotated[Path, typer.Argument(help="The detector's run directory.")],
+    data: Data,
+    split: Annotated[str, typer.Option(help="Split to compare.")] = "test",
+) -> None:
+    """How far the detected scene graphs are from the generator's on a split, at the
+    threshold chosen on val: objects found (by size, by dynamics), 3D boxes lifted with
+    depth, relations kept; writes RUN/graphs_<split>.json."""
+    import json
+
+    from seannet.detection.fidelity import graph_fidelity
+    from seannet.detection.train import load_detector
+    from seannet.provenance import append_provenance
+    from sgdata.fileio import atomic_write_text
+
+    trained = load_detector(run, data)
+    append_provenance(run, data, step="detector-graphs")
+    found = graph_fidelity(trained, data, split)
+    atomic_write_text(run / f"graphs_{split}.json", json.dumps(found, indent=1) + "\n")
+    objects, lifting, relations = found["objects"], found["lifting"], found["relations"]
+    table = Table(title=f"detected graphs of {run} on {split} (score >= {found['threshold']:g})")
+    table.add_column("measure")
+    table.add_column("value", justify="right")
+    table.add_row("true objects found (IoU 0.5, same class)", _share(objects["recall"]))
+    for group, what in (("by_size", "{} objects"), ("by_dynamics", "dynamics {}")):
+        for name, row in objects[group].items():
+            table.add_row(f"  {what.format(name)} ({row['true']:,})", _share(row["recall"]))
+    table.add_row("graph objects that are true", _share(objects["precision"]))
+    centre = lifting["centre_error_m"]
+    table.add_row(
+        "3D box centre error, median / p90 (m)",
+        "-" if centre["median"] is None else f"{centre['median']:.2f} / {centre['p90']:.2f}",
+    )
+    table.add_row("true relations with both objects found", _share(relations["with_both_ends"]))
+    table.add_row("  of those, kept", _share(relations["kept_of_those"]))
+    for name, row in relations["by_type"].items():
+        table.add_row(f"    {name} ({row['true']:,})", _share(row["kept_of_those"]))
+    console.print(table)
+    console.print(f"wrote {run / f'graphs_{split}.json'}")
+
+
+def _share(value: float | None) -> str:
+    return "-" if value is None else f"{100 * value:.1f} %"
+
+
 results_app = typer.Typer(
     rich_markup_mode=None,  # help text as written: a config's [catalog] stays
     help="The protocol of docs/results.md as units of at most 45 min, each ending in a "

@@ -30,6 +30,7 @@ DOC = ROOT / "docs" / "detector.md"
 BEGIN, END = "<!-- detector-figures -->", "<!-- /detector-figures -->"
 RUN_FILES = ("detector.json", "eval_test.json", "provenance.jsonl")
 CASES = ("N", "A")
+GRAPHS = "graphs_test.json"
 
 
 def record(detector: Path, cards: Path, data: Path, navigation: tuple[Path, ...] = ()) -> Path:
@@ -47,6 +48,8 @@ def record(detector: Path, cards: Path, data: Path, navigation: tuple[Path, ...]
     _copy(threshold, folder / "threshold.json")
     for card in sorted(cards.glob("*/card.json")):
         _copy(card, folder / "cards" / f"{card.parent.name}.json")
+    if (detector / GRAPHS).exists():  # seannet detector graphs: what the graphs lose
+        _copy(detector / GRAPHS, folder / GRAPHS)
     return folder
 
 
@@ -123,6 +126,34 @@ def _localizer_rows(folder: Path) -> list[str]:
     ]
 
 
+def _fidelity_rows(folder: Path) -> list[str]:
+    """What the detected graphs lose against the generator's, when it was recorded."""
+    if not (folder / GRAPHS).exists():
+        return []
+    found = json.loads((folder / GRAPHS).read_text())
+    objects, lifting, relations = found["objects"], found["lifting"], found["relations"]
+    rows = [("true objects found (IoU 0.5, same class)", pct(objects["recall"]))]
+    for group, what in (("by_size", "{} objects"), ("by_dynamics", "dynamics {}")):
+        rows += [(f"- {what.format(name)} ({row['true']:,})", pct(row["recall"]))
+                 for name, row in objects[group].items()]  # fmt: skip
+    centre = lifting["centre_error_m"]
+    rows += [
+        ("graph objects that are true", pct(objects["precision"])),
+        ("3D box centre error, median / p90 (m)",
+         "-" if centre["median"] is None else f"{centre['median']:.2f} / {centre['p90']:.2f}"),
+        ("true relations with both objects found", pct(relations["with_both_ends"])),
+        ("- of those, kept (same type, same direction)", pct(relations["kept_of_those"])),
+        *((f"- {name} ({row['true']:,}), kept", pct(row["kept_of_those"]))
+          for name, row in relations["by_type"].items()),
+    ]  # fmt: skip
+    return [
+        f"**What the detected graphs lose** on the {found['views']:,} {found['split']} views "
+        f"(`seannet detector graphs`, score >= {found['threshold']:g}), %:",
+        "",
+        *table(("measure", "value"), rows, right=(1,)),
+    ]
+
+
 def _navigation_rows(folder: Path) -> list[str]:
     """True against detected graphs in the navigation test, when both were recorded."""
     found = {p.stem: json.loads(p.read_text()) for p in (folder / "navigation").glob("*.json")}
@@ -144,10 +175,12 @@ def _navigation_rows(folder: Path) -> list[str]:
             ))  # fmt: skip
     any_run = next(iter(found.values()))
     episodes = any_run["test"]["episodes_per_case_and_room"]
+    made = [f"{graphs}: {found[graphs]['made']}" for graphs in ("truth", "detected")
+            if graphs in found]  # fmt: skip
     return [
-        f"**Navigation** on the test rooms ({episodes} episodes per case and room, oracle "
-        f"navigator: every failure is the localizer's or the path's), success and localization "
-        "failures (%, 95 % interval clustered by room), one seed:",
+        f"**Navigation** on the test rooms ({episodes} episodes per case and room, navigator "
+        f"`{any_run['navigator']}`), success and localization failures (%, 95 % interval "
+        "clustered by room), one seed:",
         "",
         *table(
             (
@@ -162,6 +195,8 @@ def _navigation_rows(folder: Path) -> list[str]:
             rows,
             right=range(3, 7),
         ),  # fmt: skip
+        "",
+        *(f"- {line}" for line in made),
     ]
 
 
@@ -183,13 +218,10 @@ def doc() -> str:
             f"[results/detector/{folder.name}](../results/detector/{folder.name}).",
             stamp(provenance),
             "",
-            *_detector_rows(folder),
-            "",
-            *_localizer_rows(folder),
-            "",
-            *_navigation_rows(folder),
-            "",
         ]
+        for section in (_detector_rows, _localizer_rows, _fidelity_rows, _navigation_rows):
+            rows = section(folder)
+            parts += [*rows, ""] if rows else []
     return "\n".join(parts).rstrip()
 
 

@@ -43,7 +43,10 @@ __all__ = [
     "ViewDetections",
     "choose_threshold",
     "detected_graphs",
+    "detections",
     "lifted_detections",
+    "match_boxes",
+    "placed_detections",
     "view_graph",
 ]
 
@@ -75,6 +78,12 @@ class ViewDetections:
     box_min: np.ndarray  # (n, 3)
     box_max: np.ndarray  # (n, 3)
     lifted: np.ndarray  # (n,) bool
+
+    @classmethod
+    def none(cls) -> ViewDetections:
+        """A view the detector found nothing in."""
+        return cls(np.zeros((0, 4), np.float32), np.zeros(0, np.int64), np.zeros(0),
+                   np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0, bool))  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -217,6 +226,13 @@ def _cached_split(
     return table
 
 
+def detections(
+    ds: Dataset, split: str, detector: TrainedDetector, progress: Progress | None = None
+) -> dict[str, ViewDetections]:
+    """``split``'s detections by view (a view with none is absent), from the run's cache."""
+    return _by_view(_cached_split(ds, split, detector, progress))
+
+
 def _by_view(table: pa.Table) -> dict[str, ViewDetections]:
     """The cached detections grouped by view, best first within a view."""
     cols = {
@@ -251,30 +267,35 @@ def _kept(found: ViewDetections, threshold: float) -> np.ndarray:
     return (found.score >= threshold) & (size >= 1.0).all(axis=1)
 
 
+def placed_detections(found: ViewDetections, threshold: float, slot_runs: np.ndarray) -> np.ndarray:
+    """The detections a view's graph holds, as indices into ``found`` in instance order
+    (instance k + 1 is detection ``[k]``): those :func:`_kept`, best first, while their class
+    has a slot left (the best detection, the first slot)."""
+    kept = np.flatnonzero(_kept(found, threshold))
+    used: dict[int, int] = {}
+    placed = []
+    for k in kept.tolist():
+        c = int(found.class_id[k])
+        if used.get(c, 0) < int(slot_runs[c][1]):
+            used[c] = used.get(c, 0) + 1
+            placed.append(k)
+    return np.array(placed, dtype=np.int64)
+
+
 def view_graph(
     found: ViewDetections, threshold: float, slot_runs: np.ndarray
 ) -> tuple[ObjectColumns, RelationColumns]:
     """One view's graph from its detections above ``threshold``."""
-    keep = _kept(found, threshold)
-    class_id = found.class_id[keep]
-    box2d, lo, hi, lifted = (
-        found.box2d[keep],
-        found.box_min[keep],
-        found.box_max[keep],
-        found.lifted[keep],
-    )
-    slot = np.full(len(class_id), -1, dtype=np.int64)
+    k = placed_detections(found, threshold, slot_runs)
+    class_id, box2d, lo, hi, lifted = (
+        found.class_id[k], found.box2d[k], found.box_min[k], found.box_max[k], found.lifted[k]
+    )  # fmt: skip
+    slot = np.empty(len(k), dtype=np.int64)
     used: dict[int, int] = {}
-    for k, c in enumerate(class_id.tolist()):  # best first: the best detection, first slot
-        start, run = (int(v) for v in slot_runs[c])
-        if used.get(c, 0) < run:
-            slot[k] = start + used.get(c, 0)
-            used[c] = used.get(c, 0) + 1
-    placed = slot >= 0
-    class_id, box2d, lo, hi, lifted, slot = (
-        a[placed] for a in (class_id, box2d, lo, hi, lifted, slot)
-    )
-    instance = np.arange(1, len(class_id) + 1, dtype=np.int64)
+    for i, c in enumerate(class_id.tolist()):
+        slot[i] = int(slot_runs[c][0]) + used.get(c, 0)
+        used[c] = used.get(c, 0) + 1
+    instance = np.arange(1, len(k) + 1, dtype=np.int64)
     support = infer_support(lo, hi, lifted)
     support_id = np.where(support >= 0, instance[np.maximum(support, 0)], -1)
     # an object with no depth takes part in no relation: its 3D box is unknown
@@ -284,14 +305,37 @@ def view_graph(
     return objects, (rel.src, rel.dst, rel.type.astype(np.int64))
 
 
+def match_boxes(
+    boxes: np.ndarray, classes: np.ndarray, true_boxes: np.ndarray, true_classes: np.ndarray
+) -> np.ndarray:
+    """Per detection (best first), the index of the true box it matches, or -1: an unmatched
+    true box of its class at IoU >= 0.5, the highest IoU taken (COCO's rule at AP50)."""
+    from torchvision.ops import box_iou
+
+    match = np.full(len(classes), -1, dtype=np.int64)
+    if not len(classes) or not len(true_classes):
+        return match
+    iou = box_iou(
+        torch.from_numpy(np.asarray(boxes, np.float64)),
+        torch.from_numpy(np.asarray(true_boxes, np.float64)),
+    ).numpy()
+    iou[np.asarray(classes)[:, None] != np.asarray(true_classes)[None, :]] = 0
+    taken = np.zeros(len(true_classes), dtype=bool)
+    for i, row in enumerate(iou):
+        row = np.where(taken, 0, row)
+        j = int(row.argmax())
+        if row[j] >= 0.5:
+            taken[j] = True
+            match[i] = j
+    return match
+
+
 def choose_threshold(
     found: dict[str, ViewDetections], truth: dict[str, tuple[np.ndarray, np.ndarray]]
 ) -> tuple[float, dict[float, float]]:
     """The score threshold of the best F1 on ``truth`` (per view: class ids and (n, 4)
     boxes), a detection matching an unmatched true box of its class at IoU >= 0.5, best
     score first; returns it and the F1 of every threshold tried."""
-    from torchvision.ops import box_iou
-
     curve = {}
     for t in THRESHOLDS:
         hits = predicted = actual = 0
@@ -302,20 +346,9 @@ def choose_threshold(
                 continue
             keep = _kept(view, t)
             predicted += int(keep.sum())
-            if not keep.any() or not len(classes):
-                continue
-            iou = box_iou(
-                torch.from_numpy(view.box2d[keep]).double(),
-                torch.from_numpy(np.asarray(boxes, np.float64)),
-            ).numpy()
-            iou[view.class_id[keep][:, None] != np.asarray(classes)[None, :]] = 0
-            taken = np.zeros(len(classes), dtype=bool)
-            for row in iou:
-                row = np.where(taken, 0, row)
-                j = int(row.argmax())
-                if row[j] >= 0.5:
-                    taken[j] = True
-                    hits += 1
+            hits += int(
+                (match_boxes(view.box2d[keep], view.class_id[keep], boxes, classes) >= 0).sum()
+            )
         f1 = 2 * hits / (predicted + actual) if predicted + actual else 0.0
         curve[t] = f1
     best = max(THRESHOLDS, key=lambda t: (curve[t], -t))
@@ -353,7 +386,7 @@ def detected_graphs(
         )
     found: dict[str, ViewDetections] = {}
     for split in dict.fromkeys(("val", *splits)):
-        found.update(_by_view(_cached_split(ds, split, detector, progress)))
+        found.update(detections(ds, split, detector, progress))
     val_truth = _truth(ds, "val")
     threshold, curve = choose_threshold(found, val_truth)
     atomic_write_text(
@@ -369,14 +402,7 @@ def detected_graphs(
         + "\n",
     )
     slot_runs = np.array([(c.slot_start, c.slot_count) for c in ds.manifest.classes], np.int64)
-    empty = ViewDetections(
-        np.zeros((0, 4), np.float32),
-        np.zeros(0, np.int64),
-        np.zeros(0),
-        np.zeros((0, 3)),
-        np.zeros((0, 3)),
-        np.zeros(0, bool),
-    )
+    empty = ViewDetections.none()
     views = {}
     for split in dict.fromkeys(("val", *splits)):
         for shard in ds.observation_files(split):

@@ -115,6 +115,13 @@ def test_the_benchmark_sweep_gains_a_detected_graphs_row(
     # the doc's figures come from evidence copied out of the runs, not from the runs
     scored = run_cli("seannet", "detector", "eval", detector_run, "--data", channels_dataset)
     assert scored.returncode == 0, scored.stderr
+    # what the detected graphs lose, on the test views the sweep's graphs came from
+    lost = run_cli("seannet", "detector", "graphs", detector_run, "--data", channels_dataset)
+    assert lost.returncode == 0, lost.stderr
+    fidelity = json.loads((detector_run / "graphs_test.json").read_text())
+    assert fidelity["objects"]["true"] > 0 and 0.0 <= fidelity["objects"]["recall"] <= 1.0
+    recall = f"{100 * fidelity['objects']['recall']:.1f} %"
+    assert "true objects found" in lost.stdout and recall in lost.stdout
     figures = load_script("detector_figures")
     figures.RECORDS = tmp_path / "records"
     folder = figures.record(detector_run, tmp_path / "cards", channels_dataset)
@@ -124,3 +131,5 @@ def test_the_benchmark_sweep_gains_a_detected_graphs_row(
     assert "*Made by " in text and "manifest sha256" in text  # the stamp of the commands
     accuracy = card["summary"]["accuracy"]["mean"]
     assert f"| `boxes-overlap` | {100 * accuracy:.1f} |" in text
+    assert (folder / "graphs_test.json").read_text() == json.dumps(fidelity, indent=1) + "\n"
+    assert "**What the detected graphs lose** on the" in text
