@@ -5,6 +5,7 @@ stamp)."""
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -25,7 +26,18 @@ from seannet.protocol.design import (
 )
 from seannet.protocol.records import Found
 
-__all__ = ["Records", "difference", "header", "pct", "pm", "seeds_cell", "span", "table", "verdict"]
+__all__ = [
+    "Records",
+    "difference",
+    "header",
+    "pct",
+    "pm",
+    "seeds_cell",
+    "span",
+    "strongest_baseline",
+    "table",
+    "verdict",
+]
 
 
 @dataclass
@@ -188,3 +200,15 @@ def header(r: Records, title: str, what: str) -> list[str]:
             + "."
         )
     return [*lines, ""]
+
+
+def strongest_baseline(r: Records, methods: Sequence[str]) -> str | None:
+    """The baseline with the best val accuracy (every choice on val) among the rows that are
+    not the first row's own network (its +boxes and +box-kernel are it, with a scene term)
+    and have a record."""
+    own = network_of(r.first)
+    candidates = [m for m in methods if m != r.first and r.runs(m)
+                  and (own is None or network_of(m) != own)]  # fmt: skip
+    if not candidates:
+        return None
+    return max(candidates, key=lambda m: float(np.mean([x["val_accuracy"] for x in r.runs(m)])))
