@@ -1,11 +1,13 @@
 # The two entry points of README.md; both set the machine up first (idempotent).
 # The suite runs on every core (pytest-xdist): shared artefacts are built once under a file lock
 # (tests/artefacts.py), and tests marked `quiet` run while the other workers wait. One worker
-# more than cores: a worker waits part of its time (on a lock, a server, a subprocess), and
-# the extra one fills those gaps (2 cores: 3 workers 484-532 s, 2 workers 531-578 s).
+# per core: on the 2-core AMD host of 2026-12-07 (fresh clone, quiet, one run each, in turn)
+# 2 workers took 840 s and 3 took 1,075 s (sum of test times 1,493 s against 2,754: a third
+# worker's contention costs more than the gaps it fills); on the Intel host of 2026-12-06,
+# 3 workers had won (484-532 s against 531-578 s). `make test WORKERS=3` still runs three.
 .PHONY: setup demo test test-fast test-random test-coverage lint
 
-WORKERS ?= $(shell echo $$(( $$(nproc) + 1 )))
+WORKERS ?= $(shell nproc)
 PYTEST = .venv/bin/python -m pytest -n $(WORKERS) --dist worksteal
 
 setup:
