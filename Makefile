@@ -1,10 +1,11 @@
 # The two entry points of README.md; both set the machine up first (idempotent).
 # The suite runs on every core (pytest-xdist): shared artefacts are built once under a file lock
 # (tests/artefacts.py), and tests marked `quiet` run while the other workers wait. One worker
-# per core: on the 2-core AMD host of 2026-12-07 (fresh clone, quiet, one run each, in turn)
-# 2 workers took 840 s and 3 took 1,075 s (sum of test times 1,493 s against 2,754: a third
-# worker's contention costs more than the gaps it fills); on the Intel host of 2026-12-06,
-# 3 workers had won (484-532 s against 531-578 s). `make test WORKERS=3` still runs three.
+# per core: on the 2-core AMD host of 2026-12-07 (fresh clones, quiet, four runs in turn)
+# 2 workers took 840 and 983 s, 3 took 1,000 and 1,075 s (sums of test times 1,493-1,707 s
+# against 2,518-2,754: a third worker's contention costs more than the gaps it fills); on the
+# Intel host of 2026-12-06, 3 workers had won (484-532 s against 531-578 s).
+# `make test WORKERS=3` still runs three.
 .PHONY: setup demo test test-fast test-random test-coverage lint
 
 WORKERS ?= $(shell nproc)
