@@ -827,6 +827,7 @@ def detector_graphs(
 
     from seannet.detection.fidelity import graph_fidelity
     from seannet.detection.train import load_detector
+    from seannet.markdown import pct
     from seannet.provenance import append_provenance
     from sgdata.fileio import atomic_write_text
 
@@ -837,27 +838,23 @@ def detector_graphs(
     objects, lifting, relations = found["objects"], found["lifting"], found["relations"]
     table = Table(title=f"detected graphs of {run} on {split} (score >= {found['threshold']:g})")
     table.add_column("measure")
-    table.add_column("value", justify="right")
-    table.add_row("true objects found (IoU 0.5, same class)", _share(objects["recall"]))
+    table.add_column("%", justify="right")
+    table.add_row("true objects found (IoU 0.5, same class)", pct(objects["recall"]))
     for group, what in (("by_size", "{} objects"), ("by_dynamics", "dynamics {}")):
         for name, row in objects[group].items():
-            table.add_row(f"  {what.format(name)} ({row['true']:,})", _share(row["recall"]))
-    table.add_row("graph objects that are true", _share(objects["precision"]))
+            table.add_row(f"  {what.format(name)} ({row['true']:,})", pct(row["recall"]))
+    table.add_row("graph objects that are true", pct(objects["precision"]))
     centre = lifting["centre_error_m"]
     table.add_row(
         "3D box centre error, median / p90 (m)",
         "-" if centre["median"] is None else f"{centre['median']:.2f} / {centre['p90']:.2f}",
     )
-    table.add_row("true relations with both objects found", _share(relations["with_both_ends"]))
-    table.add_row("  of those, kept", _share(relations["kept_of_those"]))
+    table.add_row("true relations with both objects found", pct(relations["with_both_ends"]))
+    table.add_row("  of those, kept", pct(relations["kept_of_those"]))
     for name, row in relations["by_type"].items():
-        table.add_row(f"    {name} ({row['true']:,})", _share(row["kept_of_those"]))
+        table.add_row(f"    {name} ({row['true']:,})", pct(row["kept_of_those"]))
     console.print(table)
     console.print(f"wrote {run / f'graphs_{split}.json'}")
-
-
-def _share(value: float | None) -> str:
-    return "-" if value is None else f"{100 * value:.1f} %"
 
 
 results_app = typer.Typer(

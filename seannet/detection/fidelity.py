@@ -21,10 +21,10 @@ import numpy as np
 from seannet.data.opening import DataSource, open_dataset
 from seannet.detection.graphs import (
     ViewDetections,
-    detected_graphs,
     detections,
     match_boxes,
     placed_detections,
+    val_threshold,
     view_graph,
 )
 from seannet.detection.train import TrainedDetector
@@ -166,9 +166,9 @@ def summary(tally: ViewTally) -> dict[str, Any]:
 
 def graph_fidelity(detector: TrainedDetector, data: DataSource, split: str) -> dict[str, Any]:
     """The detected graphs of ``split`` against the generator's (:func:`summary`), at the
-    threshold :func:`~seannet.detection.graphs.detected_graphs` chose on val."""
+    threshold chosen on val (:func:`~seannet.detection.graphs.val_threshold`)."""
     ds = open_dataset(data)
-    threshold = detected_graphs(detector, ds, [split]).threshold
+    threshold = val_threshold(ds, detector)
     found = detections(ds, split, detector)
     slot_runs = np.array([(c.slot_start, c.slot_count) for c in ds.manifest.classes], np.int64)
     tally = ViewTally()

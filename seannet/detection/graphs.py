@@ -47,6 +47,7 @@ __all__ = [
     "lifted_detections",
     "match_boxes",
     "placed_detections",
+    "val_threshold",
     "view_graph",
 ]
 
@@ -369,6 +370,28 @@ def _truth(ds: Dataset, split: str) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     return out
 
 
+def val_threshold(
+    ds: Dataset, detector: TrainedDetector, found: dict[str, ViewDetections] | None = None
+) -> float:
+    """The threshold of the best F1 on the val views (:func:`choose_threshold`), its curve
+    written beside the cache; ``found``: detections holding val's, else read from the cache."""
+    found = found if found is not None else detections(ds, "val", detector)
+    threshold, curve = choose_threshold(found, _truth(ds, "val"))
+    atomic_write_text(
+        detector.run / CACHE / ds.manifest_sha256[:16] / "threshold.json",
+        json.dumps(
+            {
+                "threshold": threshold,
+                "val_f1": {f"{t:g}": f for t, f in curve.items()},
+                **_key(ds, detector),
+            },
+            indent=1,
+        )
+        + "\n",
+    )
+    return threshold
+
+
 def detected_graphs(
     detector: TrainedDetector,
     data: DataSource,
@@ -387,20 +410,7 @@ def detected_graphs(
     found: dict[str, ViewDetections] = {}
     for split in dict.fromkeys(("val", *splits)):
         found.update(detections(ds, split, detector, progress))
-    val_truth = _truth(ds, "val")
-    threshold, curve = choose_threshold(found, val_truth)
-    atomic_write_text(
-        detector.run / CACHE / ds.manifest_sha256[:16] / "threshold.json",
-        json.dumps(
-            {
-                "threshold": threshold,
-                "val_f1": {f"{t:g}": f for t, f in curve.items()},
-                **_key(ds, detector),
-            },
-            indent=1,
-        )
-        + "\n",
-    )
+    threshold = val_threshold(ds, detector, found)
     slot_runs = np.array([(c.slot_start, c.slot_count) for c in ds.manifest.classes], np.int64)
     empty = ViewDetections.none()
     views = {}

@@ -120,7 +120,7 @@ def test_the_benchmark_sweep_gains_a_detected_graphs_row(
     assert lost.returncode == 0, lost.stderr
     fidelity = json.loads((detector_run / "graphs_test.json").read_text())
     assert fidelity["objects"]["true"] > 0 and 0.0 <= fidelity["objects"]["recall"] <= 1.0
-    recall = f"{100 * fidelity['objects']['recall']:.1f} %"
+    recall = f"{100 * fidelity['objects']['recall']:.1f}"
     assert "true objects found" in lost.stdout and recall in lost.stdout
     figures = load_script("detector_figures")
     figures.RECORDS = tmp_path / "records"
