@@ -342,8 +342,12 @@ def run_seed(
             say(f"{name}: test under box noise {noise.label()}, seed {seed}")
             noisy = h.embed("test", noise)
             right, _ = _triplets(h, noisy, "test")
+            # the map's views are read with the same graphs as the queries: a robot's map
+            # was built by the same detector
+            recall = _recall(h, noisy, config.map_layout)["recall"]
             result["box_noise"].append({**asdict(noise), "label": noise.label(),
-                                        "accuracy": float(right.mean())})  # fmt: skip
+                                        "accuracy": float(right.mean()),
+                                        "recall1": recall["1"]})  # fmt: skip
     return result, method
 
 
@@ -412,7 +416,14 @@ def summarize(runs: list[dict[str, Any]]) -> dict[str, Any]:
     }
     if "box_noise" in runs[0]:
         summary["box_noise"] = [
-            {**level, "accuracy": float(np.mean([r["box_noise"][k]["accuracy"] for r in runs]))}
+            {
+                **level,
+                **{
+                    m: float(np.mean([r["box_noise"][k][m] for r in runs]))
+                    for m in ("accuracy", "recall1")
+                    if m in level
+                },
+            }  # fmt: skip
             for k, level in enumerate(runs[0]["box_noise"])
         ]
     return summary

@@ -166,9 +166,16 @@ def _markdown(card: dict[str, Any]) -> str:
     if "covisibility" in s:
         lines += _covisibility_lines(s["covisibility"])
     if "box_noise" in s:
-        lines += ["", "Box noise (S jitter, P drop, Q spurious; accuracy %):", ""]
+        levels = s["box_noise"]
+        recall = all("recall1" in n for n in levels)  # cards made before it lack it
+        shown = "accuracy and recall@1" if recall else "accuracy"
+        lines += ["", f"Box noise (S jitter, P drop, Q spurious; {shown} %):", ""]
         lines += table(
-            ["noise", "accuracy"], [[n["label"], pct(n["accuracy"])] for n in s["box_noise"]]
+            ["noise", "accuracy", *(["recall@1"] if recall else [])],
+            [
+                [n["label"], pct(n["accuracy"]), *([pct(n["recall1"])] if recall else [])]
+                for n in levels
+            ],
         )
     if "navigation" in s:
         lines += _navigation_lines(s["navigation"])

@@ -111,6 +111,9 @@ def test_the_benchmark_sweep_gains_a_detected_graphs_row(
     labels = [n["label"] for n in card["summary"]["box_noise"]]
     assert labels[-1].startswith("detected-") and len(labels) == 6, labels
     assert 0.0 <= card["summary"]["box_noise"][-1]["accuracy"] <= 1.0
+    assert (
+        0.0 <= card["summary"]["box_noise"][-1]["recall1"] <= 1.0
+    )  # the map's graphs detected too
     assert labels[-1] in (tmp_path / "cards" / "boxes-overlap" / "card.md").read_text()
     # the doc's figures come from evidence copied out of the runs, not from the runs
     scored = run_cli("seannet", "detector", "eval", detector_run, "--data", channels_dataset)

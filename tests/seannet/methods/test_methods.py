@@ -12,8 +12,10 @@ import pytest
 import torch
 
 from seannet.data.batch import SceneBatch
+from seannet.data.box_noise import BoxNoise
 from seannet.errors import MethodError
 from seannet.methods import BenchmarkConfig, Views, benchmark_method, load_method, register_method
+from seannet.methods.benchmark import NOISE_LEVELS
 from seannet.methods.cards import leaderboard, read_cards
 
 FAST = BenchmarkConfig(seeds=(0,), batch_size=16, noise=())
@@ -160,7 +162,8 @@ def test_a_bad_method_is_one_line_and_no_card(
 
 
 def test_reference_methods_get_cards_and_a_leaderboard(tmp_path: Path, mini_dataset: Path) -> None:
-    config = BenchmarkConfig(seeds=(0,), batch_size=16)
+    # the sweep's levels, and exact boxes as one more: a level reads like the clean test
+    config = BenchmarkConfig(seeds=(0,), batch_size=16, noise=(*NOISE_LEVELS, BoxNoise()))
     for name in ("tiny-image", "boxes-overlap"):
         benchmark_method(name, mini_dataset, tmp_path, config)
     card = json.loads((tmp_path / "boxes-overlap" / "card.json").read_text())
@@ -175,6 +178,12 @@ def test_reference_methods_get_cards_and_a_leaderboard(tmp_path: Path, mini_data
     recall = summary["change_recall"]["moved_objects"]
     assert sum(b["triplets"] for b in recall.values()) == summary["queries"]  # every query
     assert len(summary["box_noise"]) == len(config.noise)  # boxes: the noise sweep ran
+    exact = summary["box_noise"][-1]
+    assert exact["label"] == "S0-P0-Q0"
+    assert exact["accuracy"] == summary["accuracy"]["mean"]
+    assert exact["recall1"] == summary["recall1"]["mean"]  # the map read as the queries are
+    assert all(0.0 <= n["recall1"] <= 1.0 for n in summary["box_noise"])
+    assert "| noise | accuracy | recall@1 |" in (tmp_path / "boxes-overlap" / "card.md").read_text()
     assert summary["bytes_per_map_entry"] > 0 and summary["ms_per_view"] > 0
     tiny = json.loads((tmp_path / "tiny-image" / "card.json").read_text())["summary"]
     assert "box_noise" not in tiny  # no boxes, no box-noise sweep
