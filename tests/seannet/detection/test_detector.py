@@ -134,5 +134,8 @@ def test_the_benchmark_sweep_gains_a_detected_graphs_row(
     assert "*Made by " in text and "manifest sha256" in text  # the stamp of the commands
     accuracy = card["summary"]["accuracy"]["mean"]
     assert f"| `boxes-overlap` | {100 * accuracy:.1f} |" in text
+    # the recall@1 columns, true then detected, from the card
+    recall = (card["summary"]["recall1"]["mean"], card["summary"]["box_noise"][-1]["recall1"])
+    assert " | {:.1f} | {:.1f} | ".format(*(100 * r for r in recall)) in text
     assert (folder / "graphs_test.json").read_text() == json.dumps(fidelity, indent=1) + "\n"
     assert "**What the detected graphs lose** on the" in text
