@@ -17,6 +17,7 @@ from __future__ import annotations
 import importlib
 import json
 import math
+import numbers
 import threading
 from collections.abc import Callable, Collection
 from dataclasses import dataclass
@@ -24,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sgdata.errors import ConfigError
+from sgdata.errors import ConfigError, one_line
 
 __all__ = ["DEFAULT_MIN_SCORE", "DETECTOR_JSON", "BoxProposer", "ProposedBox", "open_proposer"]
 
@@ -64,26 +65,55 @@ class BoxProposer:
             try:
                 found = list(self._detect(pixels))
             except Exception as exc:  # noqa: BLE001 - a detector of any library
-                raise ConfigError(
-                    f"--detector {self.run}: detection failed: {type(exc).__name__}: {exc}"
-                ) from None
+                failed = f"{type(exc).__name__}: {one_line(exc)}"
+                raise ConfigError(f"--detector {self.run}: detection failed: {failed}") from None
         kept = []
         for k, item in enumerate(found):
-            if not isinstance(item, ProposedBox) or len(item.box) != 4:
+            corners, problem = _corners(item)
+            if problem:
                 raise ConfigError(
-                    f"--detector {self.run}: result {k} is {type(item).__name__}; expected a "
-                    "sgdata.label.box_proposer.ProposedBox"
+                    f"--detector {self.run}: result {k} {problem}; expected a "
+                    "sgdata.label.box_proposer.ProposedBox (class_name: str, box: 4 numbers, "
+                    "score: a number)"
                 )
+            # NaN or infinite corners or score, an unknown class: a slip, left out
+            if not all(math.isfinite(x) for x in corners):
+                continue
             if not (math.isfinite(item.score) and item.score >= self.min_score):
                 continue
             if item.class_name not in self._known:
                 continue
-            u1, v1, u2, v2 = (round(float(x)) for x in item.box)
+            u1, v1, u2, v2 = (round(x) for x in corners)
             u1, u2 = max(0, min(u1, width)), max(0, min(u2, width))
             v1, v2 = max(0, min(v1, height)), max(0, min(v2, height))
             if u2 - u1 >= 2 and v2 - v1 >= 2:
                 kept.append(ProposedBox(item.class_name, (u1, v1, u2, v2), float(item.score)))
         return sorted(kept, key=lambda b: -b.score)
+
+
+def _number(value: object) -> bool:
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+
+
+def _corners(item: object) -> tuple[list[float], str]:
+    """A detector's result as its box's four corners, or what keeps it from being a box (the
+    detector is broken, not slipping, so the labeler hears of it)."""
+    if not isinstance(item, ProposedBox):
+        return [], f"is {type(item).__name__}"
+    if not isinstance(item.class_name, str):
+        return [], f"has a class_name of type {type(item.class_name).__name__}"
+    if not _number(item.score):
+        return [], f"has a score of type {type(item.score).__name__}"
+    try:
+        corners = list(item.box)
+    except TypeError:
+        return [], f"has a box of type {type(item.box).__name__}"
+    if len(corners) != 4:
+        return [], f"has a box of {len(corners)} values"
+    wrong = next((x for x in corners if not _number(x)), None)
+    if wrong is not None:
+        return [], f"has a box corner of type {type(wrong).__name__}"
+    return [float(x) for x in corners], ""
 
 
 def open_proposer(run: Path, *, min_score: float, known: Collection[str]) -> BoxProposer:
@@ -118,6 +148,6 @@ def open_proposer(run: Path, *, min_score: float, known: Collection[str]) -> Box
         detect = opener(Path(run))
     except Exception as exc:  # noqa: BLE001 - a detector package of any kind
         raise ConfigError(
-            f"{record_path}: proposer {target!r} failed: {type(exc).__name__}: {exc}"
+            f"{record_path}: proposer {target!r} failed: {type(exc).__name__}: {one_line(exc)}"
         ) from None
     return BoxProposer(Path(run), detect, min_score=min_score, known=known)

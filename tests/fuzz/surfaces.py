@@ -10,6 +10,7 @@ from . import (
     surface_label_files,
     surface_label_server,
     surface_methods,
+    surface_proposers,
     surface_usd_rooms,
 )
 from .harness import Surface
@@ -27,5 +28,6 @@ SURFACES: dict[str, Surface] = {
         surface_assets,
         surface_methods,
         surface_exports,
+        surface_proposers,
     )
 }

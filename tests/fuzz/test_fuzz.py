@@ -25,6 +25,7 @@ EXAMPLES = {
     "mesh assets": 40,
     "localization methods (checks)": 100,
     "detector exports (COCO, YOLO)": 16,
+    "detector runs for sgdata label --detector": 150,
 }
 # the surfaces whose examples edit copies of a dataset of the suite's (a session fixture)
 DATASETS = {

@@ -73,6 +73,25 @@ def test_boxes_are_checked_kept_above_the_floor_clipped_and_best_first(tmp_path:
                           known=KNOWN)  # fmt: skip
     with pytest.raises(ConfigError, match="result 0 is dict; expected a sgdata.label.box_prop"):
         wrong(PIXELS)
+    # a corner at NaN or infinity is a slip, left out; a corner that is not a number, a class
+    # name that is not a string, or a box of three values is a broken detector, refused
+    slips = [["Mug", [float("nan"), 0, 10, 10], 0.9], ["Mug", [0, 0, float("inf"), 10], 0.9],
+             ["Mug", [1, 1, 9, 9], 0.7]]  # fmt: skip
+    assert open_proposer(file_run(tmp_path / "slips", slips), min_score=0, known=KNOWN)(PIXELS) == [
+        ProposedBox("Mug", (1, 1, 9, 9), 0.7)
+    ]
+    for k, (row, problem) in enumerate(
+        [
+            (["Mug", ["1", 0, 10, 10], 0.9], "has a box corner of type str"),
+            ([["Mug"], [0, 0, 10, 10], 0.9], "has a class_name of type list"),
+            (["Mug", [0, 0, 10], 0.9], "has a box of 3 values"),
+            (["Mug", [0, 0, 10, 10], "0.9"], "has a score of type str"),
+        ]
+    ):
+        broken = open_proposer(file_run(tmp_path / f"broken{k}", [row]), min_score=0,
+                               known=KNOWN)  # fmt: skip
+        with pytest.raises(ConfigError, match=f"result 0 {problem}; expected"):
+            broken(PIXELS)
     failing = open_proposer(file_run(tmp_path / "fails", "fail to detect"), min_score=0,
                             known=KNOWN)  # fmt: skip
     with pytest.raises(ConfigError, match="detection failed: ValueError: a bad image"):
