@@ -69,17 +69,16 @@ class BoxProposer:
                 raise ConfigError(f"--detector {self.run}: detection failed: {failed}") from None
         kept = []
         for k, item in enumerate(found):
-            corners, problem = _corners(item)
+            values, problem = _corners(item)
             if problem:
                 raise ConfigError(
                     f"--detector {self.run}: result {k} {problem}; expected a "
                     "sgdata.label.box_proposer.ProposedBox (class_name: str, box: 4 numbers, "
                     "score: a number)"
                 )
+            *corners, score = values
             # NaN or infinite corners or score, an unknown class: a slip, left out
-            if not all(math.isfinite(x) for x in corners):
-                continue
-            if not (math.isfinite(item.score) and item.score >= self.min_score):
+            if not all(math.isfinite(x) for x in values) or score < self.min_score:
                 continue
             if item.class_name not in self._known:
                 continue
@@ -87,7 +86,7 @@ class BoxProposer:
             u1, u2 = max(0, min(u1, width)), max(0, min(u2, width))
             v1, v2 = max(0, min(v1, height)), max(0, min(v2, height))
             if u2 - u1 >= 2 and v2 - v1 >= 2:
-                kept.append(ProposedBox(item.class_name, (u1, v1, u2, v2), float(item.score)))
+                kept.append(ProposedBox(item.class_name, (u1, v1, u2, v2), score))
         return sorted(kept, key=lambda b: -b.score)
 
 
@@ -95,9 +94,17 @@ def _number(value: object) -> bool:
     return isinstance(value, numbers.Real) and not isinstance(value, bool)
 
 
+def _float(value: numbers.Real) -> float:
+    """A real number as a float; an integer too large for one is infinite (a slip)."""
+    try:
+        return float(value)
+    except OverflowError:
+        return math.inf if value > 0 else -math.inf
+
+
 def _corners(item: object) -> tuple[list[float], str]:
-    """A detector's result as its box's four corners, or what keeps it from being a box (the
-    detector is broken, not slipping, so the labeler hears of it)."""
+    """A detector's result as its box's four corners and its score, or what keeps it from
+    being a box (the detector is broken, not slipping, so the labeler hears of it)."""
     if not isinstance(item, ProposedBox):
         return [], f"is {type(item).__name__}"
     if not isinstance(item.class_name, str):
@@ -113,7 +120,7 @@ def _corners(item: object) -> tuple[list[float], str]:
     wrong = next((x for x in corners if not _number(x)), None)
     if wrong is not None:
         return [], f"has a box corner of type {type(wrong).__name__}"
-    return [float(x) for x in corners], ""
+    return [_float(x) for x in (*corners, item.score)], ""
 
 
 def open_proposer(run: Path, *, min_score: float, known: Collection[str]) -> BoxProposer:

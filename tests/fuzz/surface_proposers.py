@@ -35,8 +35,9 @@ RECORDS = (*["valid"] * 12, "missing", "not json", "list", "no proposer", "propo
 OPENERS = (*["valid"] * 12, "raises", "not callable")
 RESULTS = (*["list"] * 10, "tuple", "generator", "raises", "raises late", "none", "int")
 COORDS = (*["valid"] * 12, "nan", "inf", "-inf", "huge", "negative", "reversed", "string",
-          "none", "three", "five", "ints", "numpy")  # fmt: skip
-SCORES = (*["valid"] * 10, "nan", "inf", "negative", "above one", "string", "none", "int")
+          "none", "three", "five", "ints", "numpy", "int overflow")  # fmt: skip
+SCORES = (*["valid"] * 10, "nan", "inf", "negative", "above one", "string", "none", "int",
+          "int overflow")  # fmt: skip
 CLASSES = (*["known"] * 10, "unknown", "none", "list", "int")
 
 rows = st.fixed_dictionaries(
@@ -75,11 +76,13 @@ def _coords(r):
             "reversed": (u2, v2, u1, v1), "string": ("1", v1, u2, v2),
             "none": None, "three": (u1, v1, u2), "five": (u1, v1, u2, v2, 1.0),
             "ints": tuple(int(x) for x in (u1, v1, u2, v2)),
-            "numpy": np.array([u1, v1, u2, v2], np.float32)}[c]
+            "numpy": np.array([u1, v1, u2, v2], np.float32),
+            "int overflow": (u1, v1, 10**400, v2)}[c]
 
 def _score(r):
     return {"valid": r["value"], "nan": math.nan, "inf": math.inf, "negative": -0.5,
-            "above one": 1.5, "string": "0.9", "none": None, "int": 1}[r["score"]]
+            "above one": 1.5, "string": "0.9", "none": None, "int": 1,
+            "int overflow": 10**400}[r["score"]]
 
 def _class(r):
     return {"known": r["known"], "unknown": "Giraffe", "none": None, "list": ["Mug"],
@@ -145,9 +148,10 @@ def _expected(example: dict[str, Any]) -> list[tuple[str, tuple[int, ...], float
         if r["class"] in ("none", "list", "int") or r["score"] in ("string", "none"):
             return None
         score = {"valid": r["value"], "nan": math.nan, "inf": math.inf, "negative": -0.5,
-                 "above one": 1.5, "int": 1}[r["score"]]  # fmt: skip
+                 "above one": 1.5, "int": 1, "int overflow": math.inf}[r["score"]]  # fmt: skip
         u1, v1, u2, v2 = r["corners"]
         corners = {"nan": None, "inf": None, "-inf": None, "huge": (u1, v1, 1e300, v2),
+                   "int overflow": None,
                    "negative": (-1e6, -1e6, u2, v2), "reversed": (u2, v2, u1, v1),
                    "ints": tuple(float(int(x)) for x in (u1, v1, u2, v2))}  # fmt: skip
         box = corners.get(r["coords"], (u1, v1, u2, v2))
