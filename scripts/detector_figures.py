@@ -181,10 +181,16 @@ def _navigation_rows(folder: Path) -> list[str]:
         if graphs not in found:
             continue
         (run,) = found[graphs]["runs"]
-        for rule in ("paper", "chosen"):
-            rates = run["test"][rule]
-            chosen = f"chosen on val ({run['choice']['label']})"
-            name = "paper (S > ε)" if rule == "paper" else chosen
+        choice = run["choice"]
+        names = {
+            "paper": "paper (S > ε), eval ε",
+            "paper_val": f"paper, ε chosen on val ({choice.get('paper_label')})",
+            "chosen": f"chosen on val ({choice['label']})",
+        }
+        for rule, name in names.items():
+            rates = run["test"].get(rule)
+            if rates is None:  # a record made before the row existed
+                continue
             rows.append((
                 f"`{run['model']}`", graphs, name,
                 *(_rate(rates[case]["success"]) for case in CASES),

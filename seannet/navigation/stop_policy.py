@@ -5,7 +5,8 @@ navigation success, then the test episodes judged once by it and by the paper's 
    per case and room: every rule of :func:`seannet.navigation.stopping.candidates` is judged
    on the same traces, and the best mean success over N and A is kept.
 2. Traced episodes on the test rooms, read once: the paper's rule at the localizer's eval
-   epsilon (its own row, as the paper has it) and the chosen rule, on the same episodes.
+   epsilon (its own row, as the paper has it), the paper's rule at the epsilon val episodes
+   chose for it, and the chosen rule, on the same episodes.
 3. With a ``map_memory``, beyond the paper: the same test episodes run live, stopped by the
    chosen rule, on a map that learns the layout it is in (its own row).
 
@@ -103,6 +104,8 @@ def choose_and_test(
             "epsilon": run["epsilon"], "epsilon_source": run["epsilon_source"],
             "choice": choice,
             "test": {"paper": case_rates(run["episodes"]),
+                     "paper_val": case_rates(judged(run["episodes"], StopRule(**choice["paper"]),
+                                                    config.k_max)),
                      "chosen": case_rates(judged(run["episodes"], rule, config.k_max)),
                      **({"memory": memory} if memory is not None else {})},
         })  # fmt: skip
@@ -197,8 +200,11 @@ def stop_policy_markdown(result: dict[str, Any]) -> str:
             "",
             *table(["epsilon", "N", "A", "mean"], _curve(choice)),
         ]
-        tested = [("paper rule, eval epsilon", run["test"]["paper"]),
-                  (f"chosen: {choice['label']}", run["test"]["chosen"])]  # fmt: skip
+        tested = [("paper rule, eval epsilon", run["test"]["paper"])]
+        if "paper_val" in run["test"]:  # results made before it lack it
+            tested.append((f"paper rule, epsilon chosen on val: {choice['paper_label']}",
+                           run["test"]["paper_val"]))  # fmt: skip
+        tested.append((f"chosen: {choice['label']}", run["test"]["chosen"]))
         if "memory" in run["test"]:
             tested.append((f"chosen, map memory {result['map_memory']} (beyond the paper)",
                            run["test"]["memory"]))  # fmt: skip

@@ -183,7 +183,8 @@ def choose_rule(
     records: Sequence[dict[str, Any]], epsilon: float, *, k_max: int = K_MAX
 ) -> dict[str, Any]:
     """The rule of :func:`candidates` with the best mean success over N and A on the traced
-    val ``records``, with every candidate's val success (the curve that chose it).
+    val ``records``, with every candidate's val success (the curve that chose it), and the
+    best rule of the paper's kind (``paper``: its epsilon chosen on these episodes).
 
     Raises:
         NavigationError: no traced episode of a case.
@@ -197,5 +198,10 @@ def choose_rule(
         scored.append({"rule": asdict(rule), "label": rule.label(), "success": success,
                        "mean": sum(success.values()) / len(success)})  # fmt: skip
     best = max(scored, key=lambda row: row["mean"])  # the first of equals
+    # the paper's rule with its epsilon chosen on the same episodes: how much of the chosen
+    # rule's gain is the threshold's place, not the kind of rule
+    paper = max((row for row in scored if row["rule"]["kind"] == "paper"),
+                key=lambda row: row["mean"])  # fmt: skip
     return {"chosen": best["rule"], "label": best["label"], "val": best["success"],
+            "paper": paper["rule"], "paper_label": paper["label"],
             "eval_epsilon": epsilon, "episodes": len(records), "grid": scored}  # fmt: skip

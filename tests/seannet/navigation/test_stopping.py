@@ -89,6 +89,20 @@ def test_the_choice_is_the_best_mean_success_and_keeps_the_paper_rule_on_ties() 
     assert choice["chosen"]["epsilon"] == pytest.approx(EPS - 0.4)
     assert len(choice["grid"]) == len(candidates(EPS))
     assert candidates(EPS)[0] == StopRule("paper", EPS)
+    assert choice["paper"] == choice["chosen"]  # the best is of the paper's kind here
+
+
+def test_the_paper_rule_gets_its_own_epsilon_where_a_relative_rule_wins() -> None:
+    # S peaks off the goal before it: any epsilon the paper's rule stops on the goal at, it
+    # stops earlier at; the local rule waits for the goal to beat the segment's start
+    early, arrive = _step(0.7, 0.75, False), _step(0.65, 0.3, True)
+    records = [{"case": c, "evidence": [[early, arrive]]} for c in ("N", "A")]
+    choice = choose_rule(records, EPS)
+    assert choice["chosen"]["kind"] == "local" and choice["val"] == {"N": 1.0, "A": 1.0}
+    # the paper's best stops nowhere (epsilon above 0.7: the goal missed, not a false stop,
+    # ties keep the eval epsilon) and is said with its label
+    assert choice["paper"] == {"kind": "paper", "epsilon": EPS, "margin": 0.0, "window": 1}
+    assert choice["paper_label"] == StopRule("paper", EPS).label()
     with pytest.raises(NavigationError, match="case A"):
         choose_rule(records[:1], EPS)
 
@@ -143,6 +157,11 @@ def test_the_stop_policy_is_chosen_on_val_episodes_only(
     test = json.loads((stop_policy_run / "test" / "navigate_test.json").read_text())
     assert {e["room_id"] for e in test["runs"][0]["episodes"]} <= set(_rooms(mini_dataset, "test"))
     assert a["test"]["paper"]["N"]["total"] == 2 == a["test"]["chosen"]["A"]["total"]
+    assert a["test"]["paper_val"]["A"]["total"] == 2  # the paper's rule at its val epsilon
+    assert (
+        f"paper rule, epsilon chosen on val: {a['choice']['paper_label']}"
+        in (stop_policy_run / "stop_policy.md").read_text()
+    )
     assert a["test"]["memory"]["A"]["total"] == 2  # the map that learns its layout, live
     written = (stop_policy_run / "stop_policy.md").read_text()
     assert f"**{a['choice']['label']}**" in written and "## Test (read once)" in written
@@ -160,7 +179,8 @@ def test_the_detector_page_shows_a_recorded_stop_policy_run(
     rows = figures._navigation_rows(folder)
     assert "2 episodes per case and room" in rows[0]
     for rule, name in (
-        ("paper", "paper (S > ε)"),
+        ("paper", "paper (S > ε), eval ε"),
+        ("paper_val", f"paper, ε chosen on val ({a['choice']['paper_label']})"),
         ("chosen", f"chosen on val ({a['choice']['label']})"),
     ):
         (row,) = [r for r in rows if name in r]
