@@ -23,6 +23,7 @@ one (target >= 0.5) and the mesh files' read time: the first read of a file and 
 from __future__ import annotations
 
 import argparse
+import atexit
 import json
 import os
 import shutil
@@ -100,6 +101,7 @@ def main() -> None:
     shipped = load_catalog()
     room = generate_room("kitchen", 0, args.seed, shipped)
     tmp = Path(tempfile.mkdtemp(prefix="sgdata-bench-assets-"))
+    atexit.register(shutil.rmtree, tmp, ignore_errors=True)  # read until the bench ends
     chosen = write_meshes(room, shipped, tmp, args.max_triangles)
     meshes = load_catalog(extra=[tmp / "catalog.toml"])
     start = time.perf_counter()

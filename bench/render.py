@@ -18,7 +18,9 @@ machine skews both alike; ``textured/flat`` is the pipeline's ratio (target >= 0
 from __future__ import annotations
 
 import argparse
+import atexit
 import json
+import shutil
 import tempfile
 from pathlib import Path
 
@@ -46,6 +48,7 @@ def generated_scenes(n: int, seed: int) -> list[tuple[Room, SceneGeometry]]:
 
     out = []
     tmp = Path(tempfile.mkdtemp(prefix="sgdata-bench-"))
+    atexit.register(shutil.rmtree, tmp, ignore_errors=True)  # read until the bench ends
     for k in range(n):
         room = generate_room(types[k % len(types)], k // len(types), seed, catalog)
         path = tmp / room.room_id / "room.usda"  # textures shared in tmp/textures
