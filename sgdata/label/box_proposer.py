@@ -69,7 +69,7 @@ class BoxProposer:
                 raise ConfigError(f"--detector {self.run}: detection failed: {failed}") from None
         kept = []
         for k, item in enumerate(found):
-            values, problem = _corners(item)
+            values, problem = _box_values(item)
             if problem:
                 raise ConfigError(
                     f"--detector {self.run}: result {k} {problem}; expected a "
@@ -102,7 +102,7 @@ def _float(value: numbers.Real) -> float:
         return math.inf if value > 0 else -math.inf
 
 
-def _corners(item: object) -> tuple[list[float], str]:
+def _box_values(item: object) -> tuple[list[float], str]:
     """A detector's result as its box's four corners and its score, or what keeps it from
     being a box (the detector is broken, not slipping, so the labeler hears of it)."""
     if not isinstance(item, ProposedBox):
