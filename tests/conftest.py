@@ -283,11 +283,12 @@ def tiny_localizer_config():  # noqa: ANN201  (seannet.training.config.TrainConf
 
 @pytest.fixture
 def tiny_seannet():  # noqa: ANN201  (seannet.training.config.TrainConfig)
-    """SeanNet in seconds: ResNet-18 at 64 px, an 8 x 8 layout pathway, one batch of four
-    triplets."""
+    """SeanNet in seconds: the cpu preset's (GCN fc 512 wide) on ResNet-18 at 64 px, an 8 x 8
+    layout pathway, one batch of four triplets."""
     from seannet.training.config import TrainConfig
 
     return TrainConfig().replace(
+        model="seannet-fc512",
         depth=18,
         image_size=64,
         roi_size=4,

@@ -24,6 +24,7 @@ from seannet.weights import LITE0_WEIGHTS
 from sgdata.dataset import Dataset
 
 TINY = TrainConfig().replace(
+    graph_hidden=512,  # the cpu preset's GCN fc width, for the SeanNets compared
     depth=18,
     image_size=64,
     roi_size=4,

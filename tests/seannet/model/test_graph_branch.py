@@ -82,6 +82,7 @@ def test_graph_only_seannet_learns(tmp_path: Path, mini_dataset: Path, layout_gr
     config = TrainConfig().replace(
         layout_grid=layout_grid,
         model="seannet-graph",
+        graph_hidden=512,  # the cpu preset's GCN fc width: a step a third of the paper's 4,096
         depth=18,
         image_size=64,
         roi_size=4,

@@ -54,6 +54,7 @@ def test_eval_runs_on_a_real_dataset(tmp_path: Path, mini_dataset: Path) -> None
 
     # tests/seannet/test_train.py's CPU settings, one epoch of 3 batches
     fast = TrainConfig().replace(
+        model="seannet-fc512",
         depth=18,
         image_size=64,
         roi_size=4,
@@ -72,5 +73,5 @@ def test_eval_runs_on_a_real_dataset(tmp_path: Path, mini_dataset: Path) -> None
     assert result["triplets"] == triplets and 0.0 <= result["accuracy"] <= 1.0
     assert set(result["per_room"]) == {"bathroom_real"}
     assert "no val split" in result["threshold"]["rule"]
-    assert (tmp_path / "eval" / "eval_test.md").read_text().startswith("# seannet on test")
+    assert (tmp_path / "eval" / "eval_test.md").read_text().startswith("# seannet-fc512 on test")
     assert (tmp_path / "eval" / "heat_mean_test.png").read_bytes()[:4] == b"\x89PNG"
