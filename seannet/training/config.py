@@ -94,23 +94,25 @@ _SHORT_SCHEDULE: dict[str, Any] = {
 # The preset a command trains with when none is named: this project's machines have no GPU
 DEFAULT_PRESET = "cpu"
 
+# The default: two CPU cores in about half an hour for SeanNet, the short schedule at 112 px
+# (C4 7 x 7, RoIAlign 7), 24 batches an epoch. Its model is seannet-fc512 (the GCN's fc 512
+# wide, not the paper's 4,096): a step near ResNet-18's (docs/benchmarks.md, "A training
+# step"), as accurate under wave 3's protocol (docs/training.md, presets). Loader workers
+# would only compete with torch for the two cores.
+_CPU = TrainConfig().replace(
+    model="seannet-fc512",
+    **_SHORT_SCHEDULE,
+    image_size=112,
+    roi_size=7,
+    max_train_batches=24,
+    max_val_triplets=160,
+    num_workers=0,
+)
+
 PRESETS: dict[str, TrainConfig] = {
     # The paper: ResNet-50 at 224 px, 60 epochs, SGD 0.01 x0.7 every 10 epochs, margin 0.1.
     "paper": TrainConfig(),  # every default: ModelConfig's and the fields above
-    # The default: two CPU cores in about half an hour for SeanNet, the short schedule at
-    # 112 px (C4 7 x 7, RoIAlign 7), 24 batches an epoch. Its model is seannet-fc512 (the
-    # GCN's fc 512 wide, not the paper's 4,096): a step near ResNet-18's (docs/benchmarks.md,
-    # "A training step"), as accurate under wave 3's protocol (docs/training.md, presets).
-    # Loader workers would only compete with torch for the two cores.
-    DEFAULT_PRESET: TrainConfig().replace(
-        model="seannet-fc512",
-        **_SHORT_SCHEDULE,
-        image_size=112,
-        roi_size=7,
-        max_train_batches=24,
-        max_val_triplets=160,
-        num_workers=0,
-    ),
+    DEFAULT_PRESET: _CPU,
     # One GPU (run on an H100 with 16 cores, docs/results.md): the short schedule at the
     # datasets' 224 px with the paper's SeanNet; loader workers decode the PNGs in parallel
     # (the runs there were still loader-bound).
@@ -120,6 +122,10 @@ PRESETS: dict[str, TrainConfig] = {
         max_val_triplets=320,
         num_workers=12,
     ),
+    # A smoke run: the cpu preset at 64 px (C5 2 x 2, RoIAlign 4), a step about a third of
+    # cpu's. It checks that a chain (a method in the benchmark, a protocol, navigation) runs
+    # on your data; its figures are not comparable with cpu's. The test suite trains with it.
+    "smoke": _CPU.replace(image_size=64, roi_size=4),
 }
 
 

@@ -107,7 +107,7 @@ def test_benchmark_reads_the_manifest_once(
     done = run_cli(
         "seannet", "benchmark", "--data", mini_dataset, "--methods", "tiny-image,resnet18+boxes",
         "--out", tmp_path / "cards", "--seeds", "0", "--batches", "1", "--epochs", "1",
-        "--lrs", "0.01",
+        "--lrs", "0.01", "--preset", "smoke",
     )  # fmt: skip
     assert done.returncode == 0, done.stderr
     assert manifest_reads.of(mini_dataset) == 1

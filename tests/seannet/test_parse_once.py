@@ -38,7 +38,7 @@ def test_benchmark_parses_each_spec_once(
     done = run_cli(
         "seannet", "benchmark", "--data", mini_dataset, "--methods", "tiny-image,resnet18+boxes",
         "--out", tmp_path / "cards", "--seeds", "0,1", "--batches", "1", "--epochs", "1",
-        "--lrs", "0.01",
+        "--lrs", "0.01", "--preset", "smoke",
     )  # fmt: skip
     assert done.returncode == 0, done.stderr
     assert parses == ["resnet18+boxes"]  # was 9: 1 to find it, 2 per factory call, 2 per fit

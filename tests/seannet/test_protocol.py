@@ -40,13 +40,14 @@ from tests.artefacts import shared_artefact
 from tests.cli_runner import run_cli
 
 # 5 units: resnet18 at each lr with seed 0, tiny-image (no training), the covisibility
-# oracle, then the chosen lr's seed 1; one batch of one epoch, so a unit takes seconds
+# oracle, then the chosen lr's seed 1; one batch of one epoch at 64 px, so a unit takes seconds
 TINY = Design(
     rows=(Row("resnet18+boxes", seeds=2, noise=True), Row("tiny-image", seeds=1)),
     batches=1,
     epochs=1,
     noise_grid=(BoxNoise(jitter=0.05), AIM),
     diagnostics=(COVISIBILITY,),
+    preset="smoke",
 )
 DOCS = ("results.md", "learning-curve.md", "leaderboard.md")
 

@@ -87,7 +87,9 @@ def test_lambda_is_chosen_on_val_and_combines_one_way() -> None:
 def test_eval_and_the_benchmark_choose_the_same_lambda_and_accuracy(
     tmp_path: Path, mini_dataset: Path
 ) -> None:
-    config = BenchmarkConfig(seeds=(0,), batch_size=16, batches=1, epochs=1, noise=())
+    config = BenchmarkConfig(
+        seeds=(0,), preset="smoke", batch_size=16, batches=1, epochs=1, noise=()
+    )
     for term in ("+boxes", "+box-kernel"):
         card = json.loads(
             benchmark_method(f"resnet18{term}", mini_dataset, tmp_path, config).read_text()

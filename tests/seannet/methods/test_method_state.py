@@ -114,7 +114,7 @@ def _user_method(tmp_path: Path, *, state: bool = True) -> str:
 
 def _fitted(name: str, data: Path) -> object:
     method = load_method(name)[0]()
-    method.fit(_split(data, "train", 32, name), _split(data, "val", 32, name), Budget(seed=0))
+    method.fit(_split(data, "train", 32, name), _split(data, "val", 32, name), Budget(seed=0, preset="smoke"))
     return method
 
 
@@ -161,12 +161,14 @@ def test_a_benchmarked_network_opens_by_its_card_directory_in_a_fresh_interprete
     from seannet.model.specs import parse_spec
     from seannet.training.runs import restore_run
 
-    config = BenchmarkConfig(seeds=(0,), batch_size=16, batches=1, epochs=1, noise=())
+    config = BenchmarkConfig(
+        seeds=(0,), preset="smoke", batch_size=16, batches=1, epochs=1, noise=()
+    )
     card_file = benchmark_method("resnet18+boxes", mini_dataset, tmp_path / "cards", config)
     directory = card_file.parent
     choices = json.loads(card_file.read_text())["runs"][0]["choices"]
     # the reference: the network the fit kept, read back from its run's checkpoint
-    reference = NetworkMethod(parse_spec("resnet18+boxes"))
+    reference = NetworkMethod(parse_spec("resnet18+boxes"), preset="smoke")
     reference.model = restore_run(Path(choices["run"]), mini_dataset).model
     expected = _embed(MethodLocalizer("resnet18+boxes", reference), mini_dataset)
     fresh = _fresh_embed(directory, mini_dataset, tmp_path)

