@@ -1,11 +1,13 @@
 """Loading a script of bench/ or scripts/ as a module: the one way tests load them, for their
-tables and verbs."""
+tables and verbs, and run them in the test's own process (``run_bench``)."""
 
 from __future__ import annotations
 
 import importlib.util
 from pathlib import Path
 from types import ModuleType
+
+from .cli_runner import Done, run_main
 
 ROOT = Path(__file__).resolve().parents[1]
 BENCH = ROOT / "bench"
@@ -15,6 +17,13 @@ SCRIPTS = ROOT / "scripts"
 def load_bench(name: str) -> ModuleType:
     """``bench/<name>.py`` as a fresh module named ``bench_<name>``."""
     return _load(f"bench_{name}", BENCH / f"{name}.py")
+
+
+def run_bench(name: str, *args: object) -> Done:
+    """``python bench/<name>.py args...`` in this process: its output, and its exit status
+    from SystemExit. For tests not about the process boundary (a fresh interpreter, a
+    thread count set before torch loads)."""
+    return run_main(load_bench(name).main, f"{name}.py", *args)
 
 
 def load_script(name: str) -> ModuleType:

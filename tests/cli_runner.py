@@ -11,6 +11,7 @@ import contextlib
 import io
 import os
 import sys
+from collections.abc import Callable
 from dataclasses import dataclass
 
 
@@ -33,6 +34,12 @@ def run_cli(prog: str, *args: object, columns: int = 120) -> Done:
         from sgdata_cli.seannet_app import main
     else:
         raise ValueError(f"prog is {prog!r}: expected 'sgdata' or 'seannet'")
+    return run_main(main, prog, *args, columns=columns)
+
+
+def run_main(main: Callable[[], object], prog: str, *args: object, columns: int = 120) -> Done:
+    """Run a command's ``main`` (it reads ``sys.argv``) as ``prog args...``: a console
+    script's, or a bench script's (tests/bench_scripts.py, ``run_bench``)."""
     out, err = io.StringIO(), io.StringIO()
     argv, sys.argv = sys.argv, [prog, *map(str, args)]
     saved = os.environ.get("COLUMNS")

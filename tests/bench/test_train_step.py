@@ -4,19 +4,14 @@ step part by part, on the mini dataset's real batches."""
 from __future__ import annotations
 
 import json
-import os
 import re
 import shutil
-import subprocess
-import sys
 from pathlib import Path
 from types import ModuleType
 
-import pytest
-
 from seannet.training.step_profile import PARTS
 
-from ..bench_scripts import BENCH, load_bench
+from ..bench_scripts import load_bench, run_bench
 
 
 def _bench() -> ModuleType:
@@ -30,15 +25,9 @@ def _number(cell: str) -> float:
 def test_profile_books_the_whole_step_to_parts(mini_dataset: Path, tmp_path: Path) -> None:
     data = tmp_path / "data"  # the bench builds the image cache inside the dataset it reads:
     shutil.copytree(mini_dataset, data)  # a copy keeps the shared fixture's bytes as they were
-    command = [sys.executable, str(BENCH / "train_step.py"), str(data), "--profile"]
-    env = {**os.environ, "OMP_NUM_THREADS": "1"}  # one step of 2 triplets, quick on busy cores
-    out = subprocess.run(
-        [*command, "--batch-size", "2", "--steps", "1"],
-        capture_output=True,
-        text=True,
-        env=env,
-        check=True,
-    ).stdout
+    done = run_bench("train_step", data, "--profile", "--batch-size", "2", "--steps", "1")
+    assert done.returncode == 0, done.stderr
+    out = done.stdout
     assert "resnet18" not in out  # the profile alone: the comparison did not run
     rows = [line.split(" | ") for line in out.splitlines() if line.startswith("| ")]
     header, *parts, step = rows
@@ -61,7 +50,6 @@ def test_profile_books_the_whole_step_to_parts(mini_dataset: Path, tmp_path: Pat
     assert re.search(r"backward booked to a part: (9\d|100)\.\d %", out)
 
 
-@pytest.mark.slow  # times every network the protocol trains, in three bench processes
 def test_step_costs_are_the_budgets_calibration_and_branch_motion_trains_by_the_library_step(
     mini_dataset: Path, tmp_path: Path
 ) -> None:
@@ -75,17 +63,10 @@ def test_step_costs_are_the_budgets_calibration_and_branch_motion_trains_by_the_
     assert len(set(bench.RESULTS_NETWORKS)) == len(bench.RESULTS_NETWORKS)
     data = tmp_path / "data"
     shutil.copytree(mini_dataset, data)
-    env = {**os.environ, "OMP_NUM_THREADS": "1"}
-    command = [sys.executable, str(BENCH / "train_step.py"), str(data), "--batch-size", "2"]
-    figures = json.loads(
-        subprocess.run(
-            [*command, "--models", "resnet18,seannet-fc512", "--budget", "60", "--json"],
-            capture_output=True,
-            text=True,
-            env=env,
-            check=True,
-        ).stdout  # fmt: skip
-    )
+    step = ("train_step", data, "--batch-size", "2")
+    done = run_bench(*step, "--models", "resnet18,seannet-fc512", "--budget", "60", "--json")
+    assert done.returncode == 0, done.stderr
+    figures = json.loads(done.stdout)
     assert figures["clock"] == "thread-cpu, 1 torch thread" and figures["batch_size"] == 2
     first, fc512 = figures["networks"]
     assert (first["network"], fc512["network"]) == ("resnet18", "seannet-fc512")
@@ -93,15 +74,12 @@ def test_step_costs_are_the_budgets_calibration_and_branch_motion_trains_by_the_
         assert row["batches"] == max(1, int(60 / figures["epochs"] / row["step_s"]))
         assert row["examples"] == row["batches"] * 2 * figures["epochs"]
         assert row["step_ratio"] == row["step_s"] / first["step_s"]
-    forms = subprocess.run(
-        [*command, "--gcn-forms", "--steps", "1"], capture_output=True, text=True, env=env,
-        check=True,
-    ).stdout  # fmt: skip
-    assert "with the dense GCN" in forms and "present nodes" in forms
-    motion = subprocess.run(
-        [sys.executable, str(BENCH / "branch_motion.py"), str(data), "--batches", "1"],
-        capture_output=True, text=True, env=env, check=True,
-    ).stdout  # fmt: skip
+    forms = run_bench(*step, "--gcn-forms", "--steps", "1")
+    assert forms.returncode == 0, forms.stderr
+    assert "with the dense GCN" in forms.stdout and "present nodes" in forms.stdout
+    branch = run_bench("branch_motion", data, "--batches", "1")
+    assert branch.returncode == 0, branch.stderr
+    motion = branch.stdout
     moved = {
         line[:18].strip(): float(line[18:])
         for line in motion.splitlines()
@@ -116,11 +94,7 @@ def _branch_parts() -> list[str]:
 
 
 def test_an_unknown_network_is_one_line_before_any_timing(mini_dataset: Path) -> None:
-    done = subprocess.run(
-        [sys.executable, str(BENCH / "train_step.py"), str(mini_dataset), "--models",
-         "resnet18,nope"],
-        capture_output=True, text=True, check=False,
-    )  # fmt: skip
+    done = run_bench("train_step", mini_dataset, "--models", "resnet18,nope")
     assert done.returncode == 1 and "Traceback" not in done.stderr
     assert done.stderr.startswith("--models: model 'nope': unknown name 'nope'")
     assert len(done.stderr.strip().splitlines()) == 1 and done.stdout == ""

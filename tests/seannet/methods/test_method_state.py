@@ -114,7 +114,11 @@ def _user_method(tmp_path: Path, *, state: bool = True) -> str:
 
 def _fitted(name: str, data: Path) -> object:
     method = load_method(name)[0]()
-    method.fit(_split(data, "train", 32, name), _split(data, "val", 32, name), Budget(seed=0, preset="smoke"))
+    method.fit(
+        _split(data, "train", 32, name),
+        _split(data, "val", 32, name),
+        Budget(seed=0, preset="smoke"),
+    )
     return method
 
 
