@@ -1,6 +1,6 @@
 """examples/custom_method.py end to end: a fresh interpreter outside the package runs
 ``seannet benchmark`` with the file imported by path, on the mini dataset; a card is written.
-A bad method is one line on stderr and a non-zero exit."""
+A bad method is one line on stderr and a non-zero exit (in this process)."""
 
 from __future__ import annotations
 
@@ -9,6 +9,10 @@ import json
 import subprocess
 import sys
 from pathlib import Path
+
+import pytest
+
+from tests.cli_runner import run_cli
 
 EXAMPLE = Path(__file__).resolve().parents[3] / "examples" / "custom_method.py"
 SEANNET = [sys.executable, "-m", "sgdata_cli.seannet_app"]
@@ -51,14 +55,17 @@ def test_the_example_is_a_short_file_one_command_from_a_card(
     assert len(rows) == 1 and str(EXAMPLE.parent) not in rows[0]  # the stamp quotes the command
 
 
-def test_a_bad_method_is_one_line_on_stderr(tmp_path: Path, mini_dataset: Path) -> None:
+def test_a_bad_method_is_one_line_on_stderr(
+    tmp_path: Path, mini_dataset: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     bad = tmp_path / "bad.py"
     bad.write_text(
         "import torch\n\nclass Bad:\n    def embed(self, views):\n"
         "        return torch.full((len(views), 2), float('inf'))\n"
     )
-    done = _run("benchmark", "--data", str(mini_dataset), "--methods", f"{bad}:Bad", "--out",
-                "cards", cwd=tmp_path)  # fmt: skip
+    monkeypatch.chdir(tmp_path)  # in this process: the refusal, not the interpreter, is tested
+    done = run_cli("seannet", "benchmark", "--data", mini_dataset, "--methods", f"{bad}:Bad",
+                   "--out", "cards")  # fmt: skip
     assert done.returncode != 0
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and "bad.py:Bad" in lines[0] and "check: finite" in lines[0]
