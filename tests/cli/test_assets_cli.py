@@ -2,22 +2,18 @@
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
+import contextlib
 import tomllib
 from pathlib import Path
 
 from tests.asset_meshes import write_demo_assets
+from tests.cli_runner import Done, run_cli
 
-SGDATA = [sys.executable, "-m", "sgdata_cli.sgdata_app"]
 
-
-def run(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
-    env = {**os.environ, "COLUMNS": "160", "PYTHONPATH": str(Path(__file__).parents[2])}
-    return subprocess.run(
-        [*SGDATA, *args], capture_output=True, text=True, env=env, timeout=300, cwd=cwd
-    )
+def run(*args: str, cwd: Path) -> Done:
+    """``sgdata args...`` in this process, from the folder ``cwd`` (its paths are relative)."""
+    with contextlib.chdir(cwd):
+        return run_cli("sgdata", *args, columns=160)
 
 
 def test_assets_add_writes_the_entry_and_prints_the_measures(tmp_path: Path) -> None:
