@@ -6,6 +6,7 @@ from . import (
     surface_assets,
     surface_configs,
     surface_datasets,
+    surface_detector_coco,
     surface_exports,
     surface_label_files,
     surface_label_server,
@@ -29,5 +30,6 @@ SURFACES: dict[str, Surface] = {
         surface_methods,
         surface_exports,
         surface_proposers,
+        surface_detector_coco,
     )
 }

@@ -26,6 +26,7 @@ EXAMPLES = {
     "localization methods (checks)": 100,
     "detector exports (COCO, YOLO)": 16,
     "detector runs for sgdata label --detector": 150,
+    "COCO files seannet detector reads": 150,
 }
 # the surfaces whose examples edit copies of a dataset of the suite's (a session fixture)
 DATASETS = {

@@ -43,6 +43,22 @@ def test_a_trained_detector_records_its_curve_and_is_scored_by_pycocotools(
     assert set(score["ap50_per_class"]) == {names[a["category_id"]] for a in truth["annotations"]}
 
 
+def test_a_hand_edited_coco_file_of_a_run_is_one_line_naming_the_entry(
+    tmp_path: Path, detector_run: Path, channels_dataset: Path
+) -> None:
+    run = tmp_path / "run"
+    shutil.copytree(detector_run, run)
+    (run / "eval_test.json").unlink(missing_ok=True)  # another test's eval of the module's run
+    path = run / "coco" / "annotations" / "instances_test.json"
+    document = json.loads(path.read_text())
+    document["annotations"][1]["bbox"][0] = "12"  # a number typed as text
+    path.write_text(json.dumps(document))
+    done = run_cli("seannet", "detector", "eval", run, "--data", channels_dataset)
+    assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1, done.stderr
+    assert f"{path}: annotations[1].bbox must be four finite numbers" in done.stderr
+    assert not (run / "eval_test.json").exists()
+
+
 def test_eval_with_detected_graphs_is_its_own_file_and_reuses_the_detections(
     tmp_path: Path, detector_run: Path, channels_dataset: Path, localizer_run: Path
 ) -> None:
