@@ -29,6 +29,12 @@ def test_cpu_and_gpu_share_one_schedule() -> None:
     assert cpu.max_train_batches == 24 and gpu.max_train_batches == 0  # all, on a GPU
 
 
+def test_the_smoke_preset_is_the_cpu_preset_at_64_px() -> None:
+    cpu, smoke = preset("cpu"), preset("smoke")
+    assert (smoke.model.image_size, smoke.model.roi_size) == (64, 4)
+    assert smoke.replace(image_size=112, roi_size=7) == cpu  # nothing else differs
+
+
 def test_an_unknown_preset_names_the_known_ones() -> None:
     with pytest.raises(ModelError, match=", ".join(PRESETS)):
         preset("laptop")
