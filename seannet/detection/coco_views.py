@@ -86,55 +86,41 @@ class CocoViews(torch.utils.data.Dataset):
 MOST_PIXELS = 1e6
 
 
-def _integer(value: object) -> bool:
-    return type(value) is int  # JSON's integers; not a bool, not 1.0
-
-
 def _check_document(document: object, path: Path) -> None:
-    """Refuse, in one line naming the file and the entry, what sgdata export coco never
-    writes and the detector cannot learn from: missing lists, ids that are not integers,
-    category ids other than 1..N, an annotation naming no image or class, a box that is not
-    four finite numbers."""
-    if not isinstance(document, dict) or not all(
-        isinstance(document.get(k), list) for k in ("images", "annotations", "categories")
-    ):
-        raise DataError(
-            f"{path}: expected a COCO object with lists images, annotations and categories"
-        )
-    categories = document["categories"]
-    for k, category in enumerate(categories):
-        if not isinstance(category, dict) or not _integer(category.get("id")):
-            raise DataError(f"{path}: categories[{k}] has no integer id")
-    ids = sorted(c["id"] for c in categories)
-    if not ids or ids != list(range(1, len(ids) + 1)):
-        raise DataError(f"{path}: category ids must be 1..N, as sgdata export coco writes")
+    """Refuse, in one line naming the file and the field (the labeling tool's
+    :class:`~sgdata.label.annotations.FieldReader`), what sgdata export coco never writes and
+    the detector cannot learn from: missing lists, ids that are not integers, category ids
+    other than 1..N, an annotation naming no image or class, a box that is not four numbers
+    within :data:`MOST_PIXELS`."""
+    from sgdata.label.annotations import FieldReader
+
+    f = FieldReader(path)
+    root = f.obj(document, "top level")
+    ids = []
+    for k, category in enumerate(f.get(root, "categories", "top level", "list")):
+        ids.append(f.get(f.obj(category, f"categories[{k}]"), "id", f"categories[{k}]", "int"))
+    if sorted(ids) != list(range(1, len(ids) + 1)) or not ids:
+        raise f.fail("categories", "ids 1..N, as sgdata export coco writes")
     images: set[int] = set()
-    for k, image in enumerate(document["images"]):
-        if not isinstance(image, dict) or not _integer(image.get("id")):
-            raise DataError(f"{path}: images[{k}] has no integer id")
-        if image["id"] in images:
-            raise DataError(f"{path}: images[{k}] repeats the image id {image['id']}")
-        if not isinstance(image.get("file_name"), str):
-            raise DataError(f"{path}: images[{k}] has no file_name string")
-        images.add(image["id"])
-    for k, ann in enumerate(document["annotations"]):
-        if not isinstance(ann, dict):
-            raise DataError(f"{path}: annotations[{k}] is not an object")
-        if not _integer(ann.get("image_id")) or ann["image_id"] not in images:
-            raise DataError(f"{path}: annotations[{k}] names no image of the file (image_id)")
-        if not _integer(ann.get("category_id")) or not 1 <= ann["category_id"] <= len(ids):
-            raise DataError(f"{path}: annotations[{k}] names no category 1..{len(ids)}")
-        box = ann.get("bbox")
-        if (
-            not isinstance(box, list)
-            or len(box) != 4
-            or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in box)
-            or not all(abs(v) <= MOST_PIXELS for v in box)  # NaN fails it too
+    for k, image in enumerate(f.get(root, "images", "top level", "list")):
+        where = f"images[{k}]"
+        image_id = f.get(f.obj(image, where), "id", where, "int")
+        if image_id in images:
+            raise f.fail(f"{where}.id", f"an id no other image has, not {image_id} again")
+        f.get(image, "file_name", where, "str")
+        images.add(image_id)
+    for k, ann in enumerate(f.get(root, "annotations", "top level", "list")):
+        where = f"annotations[{k}]"
+        if f.get(f.obj(ann, where), "image_id", where, "int") not in images:
+            raise f.fail(f"{where}.image_id", "the id of an entry of images")
+        if f.get(ann, "category_id", where, "int") not in ids:
+            raise f.fail(f"{where}.category_id", "the id of an entry of categories")
+        box = f.get(ann, "bbox", where, "list")
+        if len(box) != 4 or not all(
+            isinstance(v, int | float) and not isinstance(v, bool) and abs(v) <= MOST_PIXELS
+            for v in box  # NaN fails the bound too
         ):
-            raise DataError(
-                f"{path}: annotations[{k}].bbox must be four finite numbers [x, y, width, "
-                f"height] in pixels, each within {MOST_PIXELS:.0e}"
-            )
+            raise f.fail(f"{where}.bbox", f"[x, y, width, height] numbers within {MOST_PIXELS:g}")
 
 
 def collate_detection(

@@ -5,7 +5,8 @@ export, which a person may edit by hand or replace), through
 A small valid instances file (two images, two classes, three boxes) gets up to three of the
 mutations people make to JSON (a key removed, a value retyped, made extreme or nasty text, a
 list item duplicated, an unknown key), and its images may be missing or not images. Reading
-the split and every item answers one :class:`~seannet.errors.DataError` line, or items whose
+the split and every item answers one line (:class:`~seannet.errors.DataError`, or
+:class:`~sgdata.label.annotations.AnnotationFormatError` for a field), or items whose
 boxes and labels are what an oracle written here, apart from the reader, says the file holds:
 every box of positive width and height as (x0, y0, x1, y1), in file order, with its class.
 """
@@ -20,6 +21,7 @@ from typing import Any
 from hypothesis import strategies as st
 
 from seannet.errors import SeannetError  # no torch: the fuzz suite loads it late
+from sgdata.errors import SgdataError
 
 from .harness import Surface
 from .mutations import mutated
@@ -142,5 +144,5 @@ SURFACE = Surface(
     name="COCO files seannet detector reads",
     inputs=inputs,
     feed=feed,
-    refusals=(SeannetError,),
+    refusals=(SeannetError, SgdataError),
 )

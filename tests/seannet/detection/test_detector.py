@@ -55,7 +55,7 @@ def test_a_hand_edited_coco_file_of_a_run_is_one_line_naming_the_entry(
     path.write_text(json.dumps(document))
     done = run_cli("seannet", "detector", "eval", run, "--data", channels_dataset)
     assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1, done.stderr
-    assert f"{path}: annotations[1].bbox must be four finite numbers" in done.stderr
+    assert f"{path}: annotations[1].bbox: expected [x, y, width, height] numbers" in done.stderr
     assert not (run / "eval_test.json").exists()
 
 
