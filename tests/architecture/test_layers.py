@@ -54,10 +54,12 @@ SEANNET_MAY_IMPORT = (
     "sgdata.pipeline.executors",  # spawned workers that die with their parent (navigate)
 )
 LIVE_VIEWS_MAY_IMPORT = ("sgdata.render", "sgdata.usd", "sgdata.annotate", "sgdata.world.poses")
-# the detector trains on and is scored against the COCO export any other tool would read, and
-# proposes boxes to the labeling tool through the tool's own contract
+# the detector trains on and is scored against the COCO export any other tool would read
+# (checked by the labeling tool's field reader), and proposes boxes to the labeling tool
+# through the tool's own contract
 DETECTION_MAY_IMPORT = {
     "seannet.detection.train": ("sgdata.label.coco_export",),
+    "seannet.detection.coco_views": ("sgdata.label.annotations",),
     "seannet.detection.proposer": ("sgdata.label.box_proposer",),
 }
 HEAVY = ("pxr", "pyrender", "open3d", "trimesh", "torch", "OpenGL", "sgdata.render", "sgdata.usd")
