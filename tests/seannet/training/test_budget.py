@@ -17,13 +17,15 @@ from seannet.errors import ModelError
 from seannet.training.budget import CPU_CLOCK, calibrate, calibrate_batches
 from seannet.training.config import TrainConfig
 
-# ResNet-18 at 64 px, batches of 4: a step in a fraction of a second on one thread
+# ResNet-18 at 32 px, batches of 2: a step in a quarter of a second on one thread (0.27 s
+# on the AMD host of 2026-12-07, 0.62 s at 64 px and 4 triplets), so that the six
+# calibrations of the busy-machine test take seconds
 TINY = TrainConfig().replace(
     model="resnet18",
-    image_size=64,
+    image_size=32,
     embed_dim=64,
     epochs=2,
-    batch_size=4,
+    batch_size=2,
     num_workers=0,
 )
 # busy-loop processes beside the calibration: one per core (at least 2)
