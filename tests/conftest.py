@@ -11,6 +11,7 @@ import json
 import os
 import shutil
 import sys
+import tempfile
 import time
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -477,10 +478,20 @@ def procs() -> SimpleNamespace:
 # --------------------------------------------------------------------------- xdist workers
 
 
+@pytest.hookimpl(trylast=True)  # after pytest's own, which makes the run's temp folder
 def pytest_configure(config: pytest.Config) -> None:
-    """Under xdist, each worker's torch (and the processes its tests start) gets its share of
+    """Temporary files of the run, and of every process it starts, go under the run's temp
+    folder (``TMPDIR``): a command the tests kill with SIGKILL cannot remove its own (its
+    pool's task notes), and Ray keeps its sessions under ``$TMPDIR/ray``; the suite leaves
+    nothing outside pytest's temp folder.
+
+    Under xdist, each worker's torch (and the processes its tests start) gets its share of
     the cores: torch's OpenMP threads spin while they wait, so two workers of two threads each
     on two cores burn half their time without progress."""
+    temp = run_folder(config._tmp_path_factory) / "tmp"  # type: ignore[attr-defined]
+    temp.mkdir(exist_ok=True)
+    os.environ["TMPDIR"] = str(temp)
+    tempfile.tempdir = None  # read TMPDIR again
     workers = getattr(config, "workerinput", {}).get("workercount")
     if workers:
         share = str(max(1, (os.cpu_count() or 1) // int(workers)))
