@@ -124,7 +124,7 @@ def test_carry_over_asks_before_replacing_labels(chromium, tmp_path: Path) -> No
 
 
 # The box's save answers after the class is looked up, as it did on a loaded machine.
-SLOW_SAVES = """
+LATE_SAVES = """
 const plainFetch = window.fetch;
 window.fetch = async (path, options) => {
   const answer = await plainFetch(path, options);
@@ -137,7 +137,7 @@ window.fetch = async (path, options) => {
 def test_unknown_class_is_said_with_the_closest_names(chromium, tmp_path: Path) -> None:
     """The message stays when the box's save lands after it: "saved" does not hide it."""
     photos, out = _photos(tmp_path, "p1.png"), tmp_path / "ds"
-    with labeling_page(chromium, photos, out, init=SLOW_SAVES) as page:
+    with labeling_page(chromium, photos, out, init=LATE_SAVES) as page:
         drag(page, [40, 40, 200, 200], SIZE)
         page.keyboard.type("Mugg")
         page.keyboard.press("Enter")
