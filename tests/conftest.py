@@ -343,6 +343,17 @@ def detector_copy(tmp_path_factory: pytest.TempPathFactory, detector_run: Path) 
     return run
 
 
+@pytest.fixture(scope="module")
+def one_pool() -> Iterator[None]:
+    """One spawned worker for every one-worker run of the module's tests (maps, episodes), as
+    a command of several phases keeps one (:func:`sgdata.pipeline.executors.executor_session`):
+    a fresh worker spends some 5 s importing torch and seannet before its first task."""
+    from sgdata.pipeline.executors import executor_session
+
+    with executor_session(workers=1):
+        yield
+
+
 def tiny_navigation() -> dict:
     """What the tiny navigation run used: the kill-and-resume test runs it again with these."""
     from seannet.navigation.config import NavigationTestConfig

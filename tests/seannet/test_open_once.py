@@ -19,6 +19,9 @@ from seannet.training.train import train
 from sgdata.dataset.paths import MANIFEST
 from tests.cli_runner import run_cli
 
+# one spawned worker for the module's one-worker navigations (conftest.one_pool)
+pytestmark = pytest.mark.usefixtures("one_pool")
+
 TINY = TrainConfig().replace(
     model="resnet18",
     image_size=64,

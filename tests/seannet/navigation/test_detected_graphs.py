@@ -8,6 +8,7 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from seannet.data.live_views import LiveRooms
 from seannet.detection.graphs import detected_graphs
@@ -17,6 +18,9 @@ from seannet.navigation.benchmark import run_navigation
 from seannet.navigation.config import NavigationTestConfig
 from sgdata.dataset import Dataset, observations_schema, read_table
 from tests.cli_runner import run_cli
+
+# one spawned worker for the module's one-worker navigations (conftest.one_pool)
+pytestmark = pytest.mark.usefixtures("one_pool")
 
 
 def test_a_rendered_view_gets_the_graph_its_stored_view_gets(

@@ -26,6 +26,9 @@ from sgdata.dataset import Dataset
 
 from ...cli_runner import run_cli
 
+# one spawned worker for the module's one-worker navigations (conftest.one_pool)
+pytestmark = pytest.mark.usefixtures("one_pool")
+
 ONE_EPISODE = NavigationTestConfig(episodes=1)
 
 

@@ -43,6 +43,9 @@ from sgdata.seeds import rng_for
 
 from ...cli_runner import run_cli
 
+# one spawned worker for the module's one-worker navigations (conftest.one_pool)
+pytestmark = pytest.mark.usefixtures("one_pool")
+
 EPS = 0.9
 GOAL = (4, 2, 0)
 

@@ -16,6 +16,9 @@ from seannet.navigation.benchmark import results_path
 from seannet.navigation.config import NavigationTestConfig
 from seannet.navigation.stop_threshold import best_epsilon, choose_epsilon, success_by_case
 
+# one spawned worker for the module's one-worker navigations (conftest.one_pool)
+pytestmark = pytest.mark.usefixtures("one_pool")
+
 
 def _row(epsilon: float, n: float, a: float) -> dict:
     return {"epsilon": epsilon, "success": {"N": n, "A": a}}

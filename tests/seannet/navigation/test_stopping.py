@@ -27,6 +27,9 @@ from sgdata.seeds import rng_for
 from ...bench_scripts import load_script
 from ...cli_runner import run_cli
 
+# one spawned worker for the module's one-worker navigations (conftest.one_pool)
+pytestmark = pytest.mark.usefixtures("one_pool")
+
 EPS = 0.9
 
 
