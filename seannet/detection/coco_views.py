@@ -34,7 +34,7 @@ class CocoViews(torch.utils.data.Dataset):
         path = self.folder / "annotations" / f"instances_{self.split}.json"
         try:
             document = json.loads(path.read_text())
-        except (OSError, ValueError) as exc:
+        except (OSError, ValueError, RecursionError) as exc:  # RecursionError: nested too deeply
             raise DataError(f"{path}: not a readable COCO file ({exc})") from None
         _check_document(document, path)
         self.document: dict[str, Any] = document

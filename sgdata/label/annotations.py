@@ -80,6 +80,25 @@ def read_json(path: Path) -> Any:
         raise AnnotationFormatError(
             f"{path}: not JSON (line {exc.lineno}, column {exc.colno}: {exc.msg})"
         ) from None
+    except ValueError as exc:  # an integer of more digits than Python converts (4,300)
+        raise AnnotationFormatError(
+            f"{path}: a number too long to read ({str(exc).split(':')[0]})"
+        ) from None
+    except RecursionError:
+        raise AnnotationFormatError(
+            f"{path}: not JSON this reader takes (nested too deeply)"
+        ) from None
+
+
+def _finite_number(value: Any) -> bool:
+    """A JSON number a float holds: not a bool, not NaN or infinite, and not an integer
+    beyond a float's range (JSON allows any number of digits)."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return False
+    try:
+        return math.isfinite(value)
+    except OverflowError:  # an int too large to convert to float
+        return False
 
 
 class FieldReader:
@@ -112,9 +131,7 @@ class FieldReader:
         ok = {
             "str": isinstance(value, str),
             "int": isinstance(value, int) and not isinstance(value, bool),
-            "number": isinstance(value, int | float)
-            and not isinstance(value, bool)
-            and math.isfinite(value),
+            "number": _finite_number(value),
             "list": isinstance(value, list),
             "object": isinstance(value, dict),
         }[kind]

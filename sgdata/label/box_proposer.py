@@ -141,7 +141,7 @@ def open_proposer(run: Path, *, min_score: float, known: Collection[str]) -> Box
             f"--detector {run}: no {DETECTOR_JSON}; expected a detector run "
             "(seannet detector train --out RUN)"
         ) from None
-    except (OSError, ValueError) as exc:
+    except (OSError, ValueError, RecursionError) as exc:  # RecursionError: nested too deeply
         raise ConfigError(f"{record_path}: not readable JSON ({exc})") from None
     target = record.get("proposer") if isinstance(record, dict) else None
     if not isinstance(target, str) or target.count(":") != 1:

@@ -59,6 +59,18 @@ def test_a_hand_edited_coco_file_of_a_run_is_one_line_naming_the_entry(
     assert not (run / "eval_test.json").exists()
 
 
+def test_a_coco_file_nested_too_deeply_is_one_line(tmp_path: Path) -> None:
+    from seannet.detection.coco_views import CocoViews
+    from seannet.errors import DataError
+
+    path = tmp_path / "annotations" / "instances_test.json"
+    path.parent.mkdir()
+    path.write_text("[" * 100_000 + "]" * 100_000)  # valid JSON, deeper than the parser recurses
+    with pytest.raises(DataError, match="not a readable COCO file") as caught:
+        CocoViews(tmp_path, "test")
+    assert str(path) in str(caught.value) and "\n" not in str(caught.value)
+
+
 def test_eval_with_detected_graphs_is_its_own_file_and_reuses_the_detections(
     tmp_path: Path, detector_run: Path, channels_dataset: Path, localizer_run: Path
 ) -> None:

@@ -27,6 +27,10 @@ PIXELS = np.zeros((240, 320, 3), np.uint8)
     [
         (lambda run: None, "no detector.json; expected a detector run"),
         (lambda run: (run / "detector.json").write_text("{"), "detector.json: not readable JSON"),
+        (  # valid JSON nested deeper than Python's parser recurses
+            lambda run: (run / "detector.json").write_text("[" * 100_000 + "]" * 100_000),
+            "detector.json: not readable JSON",
+        ),
         (
             lambda run: (run / "detector.json").write_text('{"classes": []}'),
             "detector.json: proposer: expected an import path 'package.module:function'",

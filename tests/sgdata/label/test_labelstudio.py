@@ -136,6 +136,10 @@ def test_unknown_classes_and_relations_in_one_error(photos_dir: Path, tmp_path: 
         ),
         ([{**_rect("a", "Mug", 1, 1, 5, 5), "original_width": None}], "original_width"),
         ([{**_rect("a", "Mug", 1, 1, 5, 5), "value": {"x": 1}}], r"value\.y: expected a number"),
+        (  # an integer of 400 digits is valid JSON, but no float holds it
+            [{**_rect("a", "Mug", 1, 1, 5, 5), "value": {"x": 10**400, "y": 1}}],
+            r"value\.x: expected a number, not 1000",
+        ),
         ([{**_rect("a", "Mug", 1, 1, 5, 5), "original_width": 640}], "is 320x240"),
     ],
 )
@@ -144,6 +148,25 @@ def test_malformed_labelstudio(
 ) -> None:
     path = tmp_path / "kitchen_ls.json"
     path.write_text(json.dumps(_task(results)))
+    with pytest.raises(AnnotationFormatError, match=expected) as info:
+        import_labels("labelstudio", path, photos_dir, tmp_path / "ds")
+    assert "kitchen_ls.json" in str(info.value) and "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize(
+    ("value", "expected"),
+    [
+        ("9" * 5000, "a number too long to read"),  # Python converts at most 4,300 digits
+        ("[" * 100_000 + "]" * 100_000, "nested too deeply"),
+    ],
+    ids=["5000-digits", "nested"],
+)
+def test_valid_json_python_cannot_hold_is_one_line(
+    photos_dir: Path, tmp_path: Path, value: str, expected: str
+) -> None:
+    path = tmp_path / "kitchen_ls.json"
+    text = json.dumps(_task([_rect("a", "Mug", 1, 1, 5, 5)]))
+    path.write_text(text.replace('"original_width": 320', f'"original_width": {value}', 1))
     with pytest.raises(AnnotationFormatError, match=expected) as info:
         import_labels("labelstudio", path, photos_dir, tmp_path / "ds")
     assert "kitchen_ls.json" in str(info.value) and "\n" not in str(info.value)
