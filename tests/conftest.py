@@ -1,7 +1,8 @@
 """Shared test fixtures: a tiny hand-built room with its render geometry, one renderer, the
 mini dataset, tiny seannet runs (a localizer, a navigation run), built once per run and shared
-by every xdist worker (tests/artefacts.py), process probes, the lock that lets a `quiet` test
-time an idle machine, and a session-end check that no process of the run survives."""
+by every xdist worker (tests/artefacts.py), one spawned worker per navigation module, process
+probes, the lock that lets a `quiet` test time an idle machine, the run's TMPDIR, and a
+session-end check that no process of the run survives."""
 
 from __future__ import annotations
 
