@@ -181,9 +181,8 @@ def _render_room_views(
 ) -> int:
     from sgdata.annotate.records import ViewPose
     from sgdata.dataset.rows import write_parquet
+    from sgdata.pipeline.layout_reader import LayoutReader
     from sgdata.pipeline.view_encoder import ViewEncoder
-    from sgdata.usd.layout_meshes import LayoutMeshes
-    from sgdata.usd.room_io import read_scene
 
     with clock.stage("renderer start"):
         annotator, class_ids = _annotator(config)
@@ -193,16 +192,21 @@ def _render_room_views(
     by_layout: dict[int, list[PoseKey]] = defaultdict(list)
     for key in poses:
         by_layout[key.layout].append(key)
+    layouts = sorted(by_layout)
+    paths = [layout_file(room_dir, layout) for layout in layouts]
     scene_paths = []
-    meshes = LayoutMeshes()  # what the room's layouts share is read once
     try:
-        with ViewEncoder(
-            config.images.format, jpeg_quality=config.images.jpeg_quality, pool=_encoding_pool()
-        ) as encoder:
-            for layout in sorted(by_layout):
-                path = layout_file(room_dir, layout)
-                with clock.stage("USD load"):
-                    room, geometry = read_scene(path, meshes)
+        with (
+            ViewEncoder(
+                config.images.format,
+                jpeg_quality=config.images.jpeg_quality,
+                pool=_worker_pool("encoding"),
+            ) as encoder,
+            LayoutReader(paths, _worker_pool("reading")) as reader,
+        ):
+            for layout, path in zip(layouts, paths, strict=True):
+                with clock.stage("USD load"):  # the wait: read while the layout before rendered
+                    room, geometry = reader.next()
                 with clock.stage("scene build"):
                     annotator.set_layout(room, geometry, layout)
                 with clock.stage("pose grid"):
@@ -234,13 +238,15 @@ def _render_room_views(
     return len(encoder)
 
 
-def _encoding_pool() -> Any:
-    """This worker's view-encoding thread, started once (it outlives each room task)."""
-    if "encoding" not in _worker:
+def _worker_pool(name: str) -> Any:
+    """This worker's ``encoding`` (views) or ``reading`` (layouts) thread, started once: it
+    outlives each room task, so the worker's threads do not grow with its rooms."""
+    if name not in _worker:
+        from sgdata.pipeline.layout_reader import reading_pool
         from sgdata.pipeline.view_encoder import encoding_pool
 
-        _worker["encoding"] = encoding_pool()
-    return _worker["encoding"]
+        _worker[name] = {"encoding": encoding_pool, "reading": reading_pool}[name]()
+    return _worker[name]
 
 
 def _stages(clock: Clock) -> dict:
