@@ -101,6 +101,10 @@ def _finite_number(value: Any) -> bool:
         return False
 
 
+# what a stored id, size or pose index fits in (Parquet's int64): JSON allows any number of digits
+_INT64 = (-(2**63), 2**63 - 1)
+
+
 class FieldReader:
     """Typed access to the fields of one file's JSON, with one-line errors naming the field."""
 
@@ -137,6 +141,8 @@ class FieldReader:
         }[kind]
         if not ok:
             raise self.fail(f"{where}.{key}", f"a {kind}, not {value!r:.40}")
+        if kind == "int" and not _INT64[0] <= value <= _INT64[1]:
+            raise self.fail(f"{where}.{key}", f"an integer within int64, not {value!r:.40}")
         return value
 
     def size(

@@ -147,6 +147,16 @@ def test_malformed_coco_names_file_and_field(
     assert "kitchen.json" in str(info.value) and "\n" not in str(info.value)
 
 
+@pytest.mark.parametrize("value", [2**63, -(10**400)], ids=["2^63", "400-digits"])
+def test_an_id_past_int64_is_one_line(photos_dir: Path, tmp_path: Path, value: int) -> None:
+    coco = _coco()
+    coco["images"][0]["id"] = coco["annotations"][0]["image_id"] = value
+    path = _write(tmp_path / "kitchen.json", coco)
+    with pytest.raises(AnnotationFormatError, match=r"images\[0\]\.id: expected an integer wi"):
+        import_labels("coco", path, photos_dir, tmp_path / "ds")
+    assert not (tmp_path / "ds").exists()
+
+
 def test_bad_files_and_maps(photos_dir: Path, tmp_path: Path) -> None:
     (tmp_path / "kitchen.json").write_text("{not json")
     with pytest.raises(AnnotationFormatError, match=r"kitchen.json: not JSON \(line 1"):
