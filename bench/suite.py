@@ -270,7 +270,9 @@ def _profile_section(runs: list[dict[str, Any]]) -> list[str]:
         "is the command's wall time by step (`scenes` and `views`: each task phase's wall); "
         "phases `scenes` and `views` are their workers' time summed, by stage, with "
         "`outside the tasks` what no task claimed (workers starting, idle while the last "
-        "rooms finish, results coming back).",
+        "rooms finish, results coming back). A worker's `USD load` is the time its main "
+        "thread waited for a layout: a room's later layouts are read on a thread of their "
+        "own while the one before renders (`sgdata.pipeline.layout_reader`).",
         "",
     ]
     return lines + table(("phase", "stage", "1 worker", "2 workers"),
