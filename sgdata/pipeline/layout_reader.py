@@ -1,10 +1,11 @@
 """A room's layout stages read one ahead, on a background thread, while the one before renders.
 
 Reading a layout (:func:`sgdata.usd.room_io.read_scene`: open and compose its stage, read its
-meshes) is pure CPU, a quarter of a second for a textured room on this project's CPUs, and
+meshes) is pure CPU, about a quarter of a second for a textured room on a 2-core host, and
 the views of the layout before it spend most of their time in the renderer's draw and
 read-back, which release the GIL. So one reading thread overlaps the two: a worker with a spare
-core hides the reads of every layout but a room's first. The layouts are read in order, each
+core hides the reads of every layout but a room's first (with as many workers as cores there
+is no core to spare, and no gain). The layouts are read in order, each
 by itself, with the room's :class:`~sgdata.usd.layout_meshes.LayoutMeshes`, so what comes back
 is what reading them one after the other in the worker's own thread gives. A worker hands
 every room the same one-thread pool (:func:`reading_pool`), so its threads do not grow with
@@ -20,6 +21,7 @@ from types import TracebackType
 
 from sgdata.usd.layout_meshes import LayoutMeshes
 from sgdata.usd.meshes import SceneGeometry
+from sgdata.usd.room_io import read_scene
 from sgdata.world.scene import Room
 
 __all__ = ["LayoutReader", "reading_pool"]
@@ -76,6 +78,4 @@ class LayoutReader:
     def _start(self, k: int) -> Future[tuple[Room, SceneGeometry]] | None:
         if k >= len(self._paths):
             return None
-        from sgdata.usd.room_io import read_scene  # late: pxr is heavy to import
-
         return self._pool.submit(read_scene, self._paths[k], self._meshes)
