@@ -14,7 +14,9 @@ room at a time and writes its shard before taking the next.
 
 With ``--profile`` the run is ``sgdata generate --profile``'s: its JSON line also holds the
 stage table (:func:`sgdata.pipeline.room_tasks.stage_order`: the command's wall time by step,
-then each task phase's worker time by stage, with the time outside the tasks). Profiling
+then each task phase's worker time by stage, with the time outside the tasks) and
+``pipeline_share``: the workers' time (wall x workers) spent in the views' own pipeline, what
+``bench/render.py`` times, on the same views. Profiling
 times every stage, so its views/s are not the plain run's.
 """
 
@@ -90,7 +92,18 @@ def run_one(
         )
         wall = time.perf_counter() - start
     views = sum(manifest["counts"]["observations"].values())
-    stages = {"profile": clock.rows(stage_order())} if clock is not None else {}
+    stages = {}
+    if clock is not None:
+        from sgdata.annotate.annotator import VIEW_STEPS
+
+        # what bench/render.py times of a view (the annotator's steps and the rest of its
+        # record), here on the very views generated: its share of the workers' time says how
+        # near the command runs to its renderer's speed, with no other rooms in the ratio
+        pipeline = sum(clock.seconds[("views", s)] for s in (*VIEW_STEPS, "view record"))
+        stages = {
+            "profile": clock.rows(stage_order()),
+            "pipeline_share": round(pipeline / (wall * workers), 4),
+        }
     return {
         "rooms": sum(len(r) for r in manifest["splits"].values()),
         "workers": workers,

@@ -275,8 +275,23 @@ def _profile_section(runs: list[dict[str, Any]]) -> list[str]:
         "own while the one before renders (`sgdata.pipeline.layout_reader`).",
         "",
     ]
-    return lines + table(("phase", "stage", "1 worker", "2 workers"),
-                         ([p, s, *c] for (p, s), c in cells.items()))  # fmt: skip
+    lines += table(("phase", "stage", "1 worker", "2 workers"),
+                   ([p, s, *c] for (p, s), c in cells.items()))  # fmt: skip
+    if all("pipeline_share" in run for run in runs):
+        shares = ", ".join(
+            f"{run['workers']} worker{'s' * (run['workers'] > 1)} {run['pipeline_share']:.2f}"
+            for run in runs
+        )
+        lines += [
+            "",
+            "Share of the workers' time (wall x workers) spent in the views' own pipeline "
+            "(render, boxes, slots, relations, view record: what `bench/render.py` times), on "
+            f"the very views generated: **{shares}**. 1.00 would be generating at the "
+            "renderer's speed; unlike the end-to-end section's ratio, no other rooms enter it, "
+            "and the pipeline's own slowdown beside the encoding and reading threads does not "
+            "show in it.",
+        ]
+    return lines
 
 
 def _loader_commands(args: argparse.Namespace, tiny: Path) -> list[list[str]]:

@@ -44,14 +44,16 @@ def test_the_page_is_the_scripts_figures(tmp_path: Path, mini_dataset: Path) -> 
     (out / "generate.json").write_text(json.dumps(record))
 
     # a profile record as bench/generate.py --profile prints it, 1 worker then 2
-    def profiled(wall: float, views: float, outside: float) -> dict:
+    def profiled(wall: float, views: float, outside: float, workers: int) -> dict:
         rows = [{"phase": "command", "stage": "views", "calls": 1, "seconds": wall, "share": 0.9},
                 {"phase": "views", "stage": "render", "calls": 70, "seconds": views, "share": 0.5},
                 {"phase": "views", "stage": "outside the tasks", "calls": 1, "seconds": outside,
                  "share": 0.25}]  # fmt: skip
-        return {"views": 70, "rooms": 2, "wall_s": wall, "profile": rows}
+        share = round(views / (wall * workers), 4)
+        return {"views": 70, "rooms": 2, "workers": workers, "wall_s": wall, "profile": rows,
+                "pipeline_share": share}  # fmt: skip
 
-    profile = [profiled(7.0, 3.5, 1.75), profiled(4.0, 3.0, 2.0)]
+    profile = [profiled(7.0, 3.5, 1.75, 1), profiled(4.0, 3.0, 2.0, 2)]
     (out / "profile.json").write_text(
         json.dumps({"measure": "profile", "stamp": stamp, "commands": [["x"]], "result": profile})
     )
@@ -90,6 +92,7 @@ def test_the_page_is_the_scripts_figures(tmp_path: Path, mini_dataset: Path) -> 
     assert "| views | render | 3.50 s (50.0 %) | 3.00 s (50.0 %) |" in doc
     assert "| views | outside the tasks | 1.75 s (25.0 %) | 2.00 s (25.0 %) |" in doc
     assert "70 views of 2 rooms: 7.0 s with 1 worker, 4.0 s with 2" in doc
+    assert "on the very views generated: **1 worker 0.50, 2 workers 0.38**" in doc
     assert "batches per epoch 1200 s buy each over 5 epochs" in doc
     # what was not measured is listed with its command; the older page is fingerprinted
     assert "## Not measured in this set" in doc
