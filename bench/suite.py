@@ -76,7 +76,7 @@ AIMS = {
     "textured/flat": ">= 0.8x",
     "2 workers / 1": ">= 1.8x",
     "1 worker / rendering alone": ">= 0.85x",
-    "Ray local / local pool": ">= 0.8x",
+    "Ray local / local pool": ">= 0.9x",  # issue 52
     "channels / RGB only": ">= 0.85x",
     "meshes / procedural, annotated view": ">= 0.5x",
 }
