@@ -287,9 +287,9 @@ def _profile_section(runs: list[dict[str, Any]]) -> list[str]:
             "Share of the workers' time (wall x workers) spent in the views' own pipeline "
             "(render, boxes, slots, relations, view record: what `bench/render.py` times), on "
             f"the very views generated: **{shares}**. 1.00 would be generating at the "
-            "renderer's speed; unlike the end-to-end section's ratio, no other rooms enter it, "
-            "and the pipeline's own slowdown beside the encoding and reading threads does not "
-            "show in it.",
+            "renderer's speed. Unlike the end-to-end section's ratio, no other rooms enter it; "
+            "unlike it too, a renderer slowed by the worker's encoding and reading threads "
+            "counts here as pipeline time, which flatters the share.",
         ]
     return lines
 
